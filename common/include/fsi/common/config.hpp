@@ -1,0 +1,90 @@
+#pragma once
+// Scene files (YAML) with strict checking: every key a component reads is recorded, and
+// `check_all_used()` turns any key nobody read into an error naming the key and the line.
+// A wrong type is an error naming the key, the expected type and the line.
+//
+// Usage:
+//   auto scene = fsi::Scene::load("configs/sdof_model.yaml", {"solid.mass=2"});
+//   auto solid = scene.section("solid");
+//   double m = solid.get<double>("mass");            // required
+//   double c = solid.get<double>("damping", 0.0);    // optional with default
+//   scene.check_all_used("solid");                   // throws fsi::ConfigError on typos
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fsi {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class ConfigSection;
+
+class Scene {
+ public:
+  // Parses `text` (the file's content); `origin` names it in error messages.
+  static Scene parse(const std::string& text, const std::string& origin,
+                     const std::vector<std::string>& overrides = {});
+  static Scene load(const std::filesystem::path& path,
+                    const std::vector<std::string>& overrides = {});
+
+  const std::string& origin() const { return state_->origin; }
+  const std::string& text() const { return state_->text; }
+  const std::vector<std::string>& overrides() const { return state_->overrides; }
+  bool has(const std::string& dotted_key) const;
+  ConfigSection root() const;
+  ConfigSection section(const std::string& name) const;  // required map
+  // Throws ConfigError listing every key under `prefix` ("" = whole file) never read.
+  void check_all_used(const std::string& prefix = "") const;
+
+ private:
+  friend class ConfigSection;
+  struct State {
+    std::string origin;
+    std::string text;
+    std::vector<std::string> overrides;
+    YAML::Node root;
+    std::set<std::string> used;  // dotted keys that were read
+  };
+  std::shared_ptr<State> state_;
+};
+
+class ConfigSection {
+ public:
+  ConfigSection(std::shared_ptr<Scene::State> state, YAML::Node node, std::string path);
+
+  bool has(const std::string& key) const;
+  template <class T>
+  T get(const std::string& key) const;  // required
+  template <class T>
+  T get(const std::string& key, const T& fallback) const;
+  ConfigSection child(const std::string& key) const;  // required map
+  std::optional<ConfigSection> optional_child(const std::string& key) const;
+  std::vector<ConfigSection> list(const std::string& key) const;  // sequence of maps
+  std::vector<std::string> keys() const;
+  const std::string& path() const { return path_; }
+  std::string where(const std::string& key) const;  // "file:line:col" of a key
+  std::string full_key(const std::string& key) const;
+  // An error that names the key and its place, e.g. for a value out of range.
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+
+ private:
+  YAML::Node lookup(const std::string& key) const;
+  template <class T>
+  T convert(const std::string& key, const YAML::Node& value) const;
+  std::shared_ptr<Scene::State> state_;
+  YAML::Node node_;
+  std::string path_;
+};
+
+}  // namespace fsi
+
+#include "fsi/common/config_impl.hpp"

@@ -1,0 +1,105 @@
+#pragma once
+// The physics-side contract of a solver server: what the coupler needs from a solid or a
+// fluid, in Eigen types. The service layer (protocol/) translates wire messages into
+// these calls; the solvers know nothing of sockets or protobuf.
+//
+// Interface vectors are interleaved per node: [x0, y0, x1, y1, ...].
+//
+// Call order (enforced by the service layer):
+//   configure() -> interface() -> { solve_step(k = 1..) ... accept_step() } ... -> write_output()
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fsi/common/config.hpp"
+
+namespace fsi {
+
+// A failure of the solver itself (no convergence, tangled mesh, singular matrix).
+class SolverError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct InterfaceMeshData {
+  std::vector<std::int64_t> node_ids;
+  Eigen::MatrixX2d coordinates;                // reference configuration, n x 2
+  std::vector<std::array<int, 2>> segments;    // local indices; empty for a point interface
+  Eigen::VectorXd lumped_measure;              // used when segments is empty (size n)
+  std::size_t nodes() const { return static_cast<std::size_t>(coordinates.rows()); }
+};
+
+struct StepInfo {
+  double time = 0;   // t_{n+1}
+  double dt = 0;
+  int step = 0;      // n+1
+  int iteration = 0; // coupling iteration k (1-based); 0 when standalone
+};
+
+struct SolidSetup {
+  double dt = 0;
+  double end_time = 0;
+  double interface_damping = 0;  // gamma_N1 for Algorithm 2, else 0
+  std::filesystem::path output_dir;  // empty = write nothing
+};
+
+struct SolidStepResult {
+  Eigen::VectorXd interface_displacement;  // 2n
+  Eigen::VectorXd interface_velocity;      // 2n
+  int newton_iterations = 0;
+};
+
+class SolidModel {
+ public:
+  virtual ~SolidModel() = default;
+  virtual std::string name() const = 0;
+  virtual bool supports_interface_damping() const { return true; }
+  // Reads this solver's section of the scene; must read every key it accepts.
+  virtual void configure(const ConfigSection& section, const SolidSetup& setup) = 0;
+  virtual InterfaceMeshData interface() const = 0;
+  // Solves step n+1 for the nodal interface force F^(k)_{n+1} (2n). Repeated calls for the
+  // same step restart from the last accepted state.
+  virtual SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) = 0;
+  // Makes the last solve the new accepted state; returns named probes.
+  virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
+  virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
+};
+
+struct FluidSetup {
+  double dt = 0;
+  double end_time = 0;
+  double nitsche_penalty = 0;    // gamma_N1
+  double nitsche_symmetry = -1;  // gamma_N2
+  std::filesystem::path output_dir;
+};
+
+struct FluidLoads {
+  Eigen::VectorXd traction_force;     // f_sigma = int N^T sigma n dgamma (2n)
+  Eigen::VectorXd velocity_integral;  // f_v = int N^T v_f dgamma (2n)
+  int nonlinear_iterations = 0;
+};
+
+class FluidModel {
+ public:
+  virtual ~FluidModel() = default;
+  virtual std::string name() const = 0;
+  virtual void configure(const ConfigSection& section, const FluidSetup& setup) = 0;
+  virtual InterfaceMeshData interface() const = 0;
+  // Loads of the initial state for the given interface state (for the predictor F_0).
+  virtual FluidLoads initial_loads(const Eigen::VectorXd& interface_displacement,
+                                   const Eigen::VectorXd& interface_velocity) = 0;
+  // Moves the mesh to the interface displacement, imposes the interface velocity by
+  // Nitsche's method, solves step n+1 and returns the interface loads.
+  virtual FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                                const Eigen::VectorXd& interface_velocity) = 0;
+  virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
+  virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
+};
+
+}  // namespace fsi

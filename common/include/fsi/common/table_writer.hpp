@@ -1,0 +1,27 @@
+#pragma once
+// CSV tables written row by row and flushed after each row, so a run that dies keeps
+// every row written before.
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fsi {
+
+class CsvWriter {
+ public:
+  CsvWriter() = default;
+  CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns);
+  bool is_open() const { return out_.is_open(); }
+  std::size_t columns() const { return columns_; }
+  // Writes one row; throws std::invalid_argument if its size differs from the header's.
+  void row(const std::vector<double>& values);
+  void row(const std::vector<std::string>& values);
+
+ private:
+  std::ofstream out_;
+  std::size_t columns_ = 0;
+  std::filesystem::path path_;
+};
+
+}  // namespace fsi

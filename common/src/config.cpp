@@ -1,0 +1,187 @@
+#include "fsi/common/config.hpp"
+
+#include <fstream>
+#include <sstream>
+
+namespace fsi {
+namespace {
+
+std::string mark_string(const std::string& origin, const YAML::Mark& mark) {
+  if (mark.is_null()) return origin + " (--set)";
+  return origin + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+std::vector<std::string> split_dotted(const std::string& key) {
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  std::string part;
+  while (std::getline(ss, part, '.')) parts.push_back(part);
+  return parts;
+}
+
+void apply_override(YAML::Node root, const std::string& assignment, const std::string& origin) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ConfigError("--set '" + assignment + "': expected dotted.key=value");
+  const auto parts = split_dotted(assignment.substr(0, eq));
+  YAML::Node value;
+  try {
+    value = YAML::Load(assignment.substr(eq + 1));
+  } catch (const YAML::Exception& e) {
+    throw ConfigError("--set '" + assignment + "': value is not valid YAML: " + e.msg);
+  }
+  // Walk with explicit node copies: yaml-cpp's operator[] on a reference re-binds.
+  std::vector<YAML::Node> chain{root};
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    YAML::Node next = chain.back()[parts[i]];
+    if (next && !next.IsMap())
+      throw ConfigError("--set '" + assignment + "': '" + parts[i] + "' in " + origin +
+                        " is not a section");
+    chain.push_back(next);
+  }
+  chain.back()[parts.back()] = value;
+}
+
+void collect_unused(const YAML::Node& node, const std::string& path,
+                    const std::set<std::string>& used, const std::string& origin,
+                    std::vector<std::string>& unknown) {
+  if (!node.IsMap()) return;
+  for (const auto& kv : node) {
+    const std::string key = kv.first.Scalar();
+    const std::string full = path.empty() ? key : path + "." + key;
+    if (!used.count(full)) {
+      unknown.push_back("'" + full + "' at " + mark_string(origin, kv.first.Mark()));
+    } else if (kv.second.IsMap()) {
+      collect_unused(kv.second, full, used, origin, unknown);
+    } else if (kv.second.IsSequence()) {
+      for (std::size_t i = 0; i < kv.second.size(); ++i)
+        collect_unused(kv.second[i], full + "[" + std::to_string(i) + "]", used, origin, unknown);
+    }
+  }
+}
+
+}  // namespace
+
+Scene Scene::parse(const std::string& text, const std::string& origin,
+                   const std::vector<std::string>& overrides) {
+  Scene scene;
+  scene.state_ = std::make_shared<State>();
+  scene.state_->origin = origin;
+  scene.state_->text = text;
+  scene.state_->overrides = overrides;
+  try {
+    scene.state_->root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(mark_string(origin, e.mark) + ": not valid YAML: " + e.msg);
+  }
+  if (!scene.state_->root || scene.state_->root.IsNull()) scene.state_->root = YAML::Node(YAML::NodeType::Map);
+  if (!scene.state_->root.IsMap()) throw ConfigError(origin + ": a scene must be a YAML map of sections");
+  for (const auto& o : overrides) apply_override(scene.state_->root, o, origin);
+  return scene;
+}
+
+Scene Scene::load(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError("cannot open scene file '" + path.string() + "'");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse(buffer.str(), path.string(), overrides);
+}
+
+bool Scene::has(const std::string& dotted_key) const {
+  YAML::Node node = state_->root;
+  for (const auto& part : split_dotted(dotted_key)) {
+    if (!node.IsMap()) return false;
+    node = node[part];
+    if (!node) return false;
+  }
+  return true;
+}
+
+ConfigSection Scene::root() const { return ConfigSection(state_, state_->root, ""); }
+
+ConfigSection Scene::section(const std::string& name) const { return root().child(name); }
+
+void Scene::check_all_used(const std::string& prefix) const {
+  std::vector<std::string> unknown;
+  YAML::Node node = state_->root;
+  if (!prefix.empty()) {
+    for (const auto& part : split_dotted(prefix)) node = node[part];
+    if (!node) return;
+    if (!state_->used.count(prefix)) {
+      throw ConfigError("section '" + prefix + "' in " + state_->origin + " was not read");
+    }
+  }
+  collect_unused(node, prefix, state_->used, state_->origin, unknown);
+  if (unknown.empty()) return;
+  std::string msg = "unknown key" + std::string(unknown.size() > 1 ? "s" : "") + " in scene: ";
+  for (std::size_t i = 0; i < unknown.size(); ++i) msg += (i ? ", " : "") + unknown[i];
+  throw ConfigError(msg);
+}
+
+ConfigSection::ConfigSection(std::shared_ptr<Scene::State> state, YAML::Node node, std::string path)
+    : state_(std::move(state)), node_(node), path_(std::move(path)) {}
+
+std::string ConfigSection::full_key(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+YAML::Node ConfigSection::lookup(const std::string& key) const {
+  state_->used.insert(full_key(key));
+  if (!node_.IsMap()) return YAML::Node();
+  for (const auto& kv : node_)
+    if (kv.first.Scalar() == key) return kv.second;
+  return YAML::Node();
+}
+
+bool ConfigSection::has(const std::string& key) const {
+  if (!node_.IsMap()) return false;
+  for (const auto& kv : node_)
+    if (kv.first.Scalar() == key) return true;
+  return false;
+}
+
+std::string ConfigSection::where(const std::string& key) const {
+  if (node_.IsMap())
+    for (const auto& kv : node_)
+      if (kv.first.Scalar() == key) return mark_string(state_->origin, kv.first.Mark());
+  return mark_string(state_->origin, node_.Mark());
+}
+
+void ConfigSection::fail(const std::string& key, const std::string& message) const {
+  throw ConfigError(where(key) + ": '" + full_key(key) + "' " + message);
+}
+
+ConfigSection ConfigSection::child(const std::string& key) const {
+  YAML::Node value = lookup(key);
+  if (!value) fail(key, "is required but missing (a section)");
+  if (!value.IsMap()) fail(key, "must be a section (a map of keys)");
+  return ConfigSection(state_, value, full_key(key));
+}
+
+std::optional<ConfigSection> ConfigSection::optional_child(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  return child(key);
+}
+
+std::vector<ConfigSection> ConfigSection::list(const std::string& key) const {
+  YAML::Node value = lookup(key);
+  std::vector<ConfigSection> items;
+  if (!value || value.IsNull()) return items;
+  if (!value.IsSequence()) fail(key, "must be a list");
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string item_path = full_key(key) + "[" + std::to_string(i) + "]";
+    state_->used.insert(item_path);
+    items.emplace_back(state_, value[i], item_path);
+  }
+  return items;
+}
+
+std::vector<std::string> ConfigSection::keys() const {
+  std::vector<std::string> out;
+  if (node_.IsMap())
+    for (const auto& kv : node_) out.push_back(kv.first.Scalar());
+  return out;
+}
+
+}  // namespace fsi
