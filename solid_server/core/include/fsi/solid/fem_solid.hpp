@@ -1,0 +1,80 @@
+#pragma once
+// FemSolid: the finite-strain Q4 solid as an fsi::SolidModel (issue 3).
+//
+// Call order (the contract of solver_model.hpp):
+//   configure(section, setup) -> interface() -> { solve_step(info, F) ... accept_step(info) } -> write_output(info)
+// Each solve_step restarts from the last accepted state, so the coupler may call it any
+// number of times per step. Standalone use passes a zero interface force (or an empty
+// vector when the scene defines no interface); gravity and edge loads come from the section.
+//
+// Equations (paper, eq. solid-discrete-impl2):  M a + M_fs v + F_int(d) = F_ext + F_interface
+//   M_fs = gamma_N1 * int_interface N^T N dgamma  (reference configuration; only when the
+//   coupler sets SolidSetup::interface_damping > 0).
+// Schemes: `bdf1` (the paper: v = (d - d_n)/dt, a = (v - v_n)/dt), `newmark` (trapezoidal
+// rule, beta = 1/4, gamma = 1/2: second order, no numerical damping), and `static`
+// analysis (equilibrium with the full load in `load_steps` increments per step).
+// The scene keys are documented in configs/csm1.yaml and docs/solid.md.
+#include <Eigen/Core>
+
+#include <memory>
+#include <optional>
+
+#include "fsi/common/solver_model.hpp"
+#include "fsi/common/vtk_writer.hpp"
+#include "fsi/solid/solid_system.hpp"
+
+namespace fsi::solid {
+
+enum class TimeScheme { Static, Bdf1, Newmark };
+
+struct Probe {
+  std::string name;
+  Eigen::Vector2d point;
+  int cell = -1;
+  Eigen::Vector2d xi;  // natural coordinates in `cell`
+};
+
+class FemSolid : public fsi::SolidModel {
+ public:
+  FemSolid() = default;
+  std::string name() const override { return "fem"; }
+  void configure(const ConfigSection& section, const SolidSetup& setup) override;
+  InterfaceMeshData interface() const override { return interface_; }
+  SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
+  std::map<std::string, double> accept_step(const StepInfo& info) override;
+  std::vector<std::string> write_output(const StepInfo& info) override;
+
+  // State access (tests, benchmarks).
+  const SolidSystem& system() const { return *system_; }
+  SolidSystem& system() { return *system_; }
+  const Eigen::VectorXd& displacement() const { return d_; }  // last solve (trial) state
+  const Eigen::VectorXd& velocity() const { return v_; }
+  TimeScheme scheme() const { return scheme_; }
+  Eigen::Vector2d probe_displacement(const Probe& p, const Eigen::VectorXd& d) const;
+  const std::vector<Probe>& probes() const { return probes_; }
+  int last_newton_iterations() const { return last_iterations_; }
+
+ private:
+  Eigen::VectorXd external_force(const Eigen::VectorXd& interface_force) const;
+  void newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTerms& t, const StepInfo& info);
+
+  SolidMesh mesh_;
+  std::unique_ptr<SolidSystem> system_;
+  SolidSetup setup_;
+  TimeScheme scheme_ = TimeScheme::Static;
+  int load_steps_ = 1;
+  NewtonOptions newton_;
+  Eigen::VectorXd dead_load_;            // gravity + edge tractions
+  std::vector<int> interface_nodes_;     // global node ids
+  InterfaceMeshData interface_;
+  std::vector<Probe> probes_;
+  int output_every_ = 1;
+  std::optional<PvdSeries> series_;
+  // Accepted (n) and trial (n+1) states.
+  Eigen::VectorXd d_n_, v_n_, a_n_, f_n_;
+  Eigen::VectorXd d_, v_, a_, f_;
+  int last_iterations_ = 0;
+  bool solved_ = false;
+};
+
+}  // namespace fsi::solid

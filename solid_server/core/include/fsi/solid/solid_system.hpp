@@ -1,0 +1,137 @@
+#pragma once
+// The discrete solid: assembly of internal force and tangent on a fixed sparsity pattern,
+// constant operators (mass, interface mass, body force), Dirichlet dofs by elimination,
+// and a Newton solver for
+//     R(d) = M (c_a d + a_hist) + C (c_v d + v_hist) + F_int(d) - F_ext = 0
+// on the free dofs (c_a = c_v = 0 for statics). The time scheme lives in the caller.
+//
+// Usage:
+//   SolidSystem sys(mesh, material, density, fixed);   // fixed: one flag per dof
+//   sys.set_damping(sys.boundary_mass(edges, gamma));   // optional (Algorithm 2)
+//   NewtonReport r = sys.solve(d, f_ext, terms, options);
+// The sparsity pattern is analysed once (first solve); each Newton iteration
+// refactorises numerically only.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fsi/solid/material.hpp"
+#include "fsi/solid/mesh.hpp"
+
+namespace fsi::solid {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+enum class LinearSolverKind { Cholmod, Umfpack };
+
+// Sparse direct solver with the symbolic analysis done once. CHOLMOD (supernodal LLT)
+// for the symmetric positive definite tangent; when a factorisation reports a non-positive
+// pivot it switches to UMFPACK (LU) for good.
+class SparseDirectSolver {
+ public:
+  explicit SparseDirectSolver(LinearSolverKind kind = LinearSolverKind::Cholmod);
+  ~SparseDirectSolver();
+  SparseDirectSolver(SparseDirectSolver&&) noexcept;
+  SparseDirectSolver& operator=(SparseDirectSolver&&) noexcept;
+  void factorize(const SparseMatrix& A);  // analyses the pattern on the first call
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  LinearSolverKind kind() const { return kind_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  LinearSolverKind kind_;
+};
+
+struct TimeTerms {
+  double mass_coefficient = 0;     // c_a: a = c_a d + a_hist
+  double damping_coefficient = 0;  // c_v: v = c_v d + v_hist
+  Eigen::VectorXd acceleration_history;  // a_hist (empty = 0)
+  Eigen::VectorXd velocity_history;      // v_hist (empty = 0)
+};
+
+struct NewtonOptions {
+  int max_iterations = 25;
+  double residual_tolerance = 1e-8;   // ||R_k|| <= tol * max(||R_0||, ||F_ext||)
+  double increment_tolerance = 1e-10; // ||dd|| <= tol * ||d||
+};
+
+struct NewtonReport {
+  int iterations = 0;
+  double residual = 0;      // last ||R|| (free dofs)
+  double initial_residual = 0;
+  bool converged = false;
+};
+
+// Thrown by assembly for a non-positive det F (names the element).
+struct InvertedElement : std::runtime_error {
+  InvertedElement(int element, double det_F);
+  int element;
+  double det_F;
+};
+
+class SolidSystem {
+ public:
+  SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> material, double density,
+              std::vector<char> fixed_dofs, LinearSolverKind solver = LinearSolverKind::Cholmod);
+
+  int num_dofs() const { return 2 * mesh_.num_nodes(); }
+  int num_free() const { return static_cast<int>(free_dofs_.size()); }
+  const SolidMesh& mesh() const { return mesh_; }
+  const Material& material() const { return *material_; }
+  const std::vector<char>& fixed() const { return fixed_; }
+
+  const SparseMatrix& mass() const { return mass_; }  // full, consistent
+  // weight * int N^T N ds on the given edges (reference configuration), full size.
+  SparseMatrix boundary_mass(const std::vector<std::array<int, 2>>& edges, double weight) const;
+  void set_damping(SparseMatrix damping);  // C in R(d); pattern must fit the mesh's
+  const SparseMatrix& damping() const { return damping_; }
+
+  Eigen::VectorXd body_force(const Eigen::Vector2d& force_per_volume) const;
+  Eigen::VectorXd body_force(const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& f, int gauss = 3) const;
+
+  // Internal force F_int(d) (full size). Throws InvertedElement.
+  Eigen::VectorXd internal_force(const Eigen::VectorXd& d) const;
+  // Full residual R(d) (all dofs; on fixed dofs it is the reaction with opposite sign).
+  Eigen::VectorXd residual(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t) const;
+  // Tangent on the free dofs: K(d) + c_a M + c_v C, and the free part of the residual.
+  void assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t,
+                SparseMatrix& tangent, Eigen::VectorXd& residual_free) const;
+
+  // Newton on the free dofs; d holds the prescribed values on fixed dofs and the initial
+  // guess elsewhere. Does not throw on non-convergence (see the report); throws
+  // InvertedElement.
+  NewtonReport solve(Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t,
+                     const NewtonOptions& options);
+  // Solves M_ff x = b_f on the free dofs (x = 0 on fixed dofs), e.g. initial accelerations.
+  Eigen::VectorXd solve_mass(const Eigen::VectorXd& b) const;
+
+  // Linear solver state (for timings and tests).
+  SparseDirectSolver& linear_solver() { return solver_; }
+  int equation(int dof) const { return equation_[dof]; }
+
+  Eigen::Matrix<double, 4, 2> cell_coordinates(int cell) const;
+  Eigen::Matrix<double, 8, 1> cell_values(int cell, const Eigen::VectorXd& d) const;
+
+ private:
+  int position(int row, int col) const;  // value index in the full pattern
+  SolidMesh mesh_;
+  std::shared_ptr<const Material> material_;
+  double density_;
+  std::vector<char> fixed_;
+  std::vector<int> equation_;     // dof -> free equation or -1
+  std::vector<int> free_dofs_;    // equation -> dof
+  SparseMatrix pattern_;          // full pattern (values zero)
+  SparseMatrix mass_, damping_;   // full, on pattern_
+  SparseMatrix reduced_pattern_;  // free x free
+  std::vector<int> full_to_reduced_;  // value index map, -1 for fixed rows/cols
+  std::vector<int> cell_positions_;   // 64 per cell: full value index
+  SparseDirectSolver solver_;
+};
+
+}  // namespace fsi::solid

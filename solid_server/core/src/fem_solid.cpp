@@ -1,0 +1,356 @@
+#include "fsi/solid/fem_solid.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "fsi/common/log.hpp"
+#include "fsi/solid/element.hpp"
+
+#ifdef FSI_HAVE_GMSH_READER
+#include "fsi/common/gmsh_reader.hpp"
+#endif
+
+namespace fsi::solid {
+
+namespace {
+
+// A key that is either one name or a list of names.
+std::vector<std::string> names(const ConfigSection& s, const std::string& key) {
+  if (!s.has(key)) return {};
+  try {
+    return {s.get<std::string>(key)};
+  } catch (const ConfigError&) {
+    return s.get<std::vector<std::string>>(key);
+  }
+}
+
+Eigen::Vector2d vec2(const ConfigSection& s, const std::string& key, std::optional<Eigen::Vector2d> fallback = {}) {
+  if (!s.has(key) && fallback) {
+    s.get<std::string>(key, "");  // mark as read
+    return *fallback;
+  }
+  const auto v = s.get<std::vector<double>>(key);
+  if (v.size() != 2) s.fail(key, "must be a list of 2 numbers");
+  return {v[0], v[1]};
+}
+
+// A file named in the scene: relative paths are relative to the scene file's folder.
+std::filesystem::path scene_path(const ConfigSection& s, const std::string& key) {
+  std::filesystem::path p = s.get<std::string>(key);
+  if (p.is_absolute()) return p;
+  std::string where = s.where(key);  // "file:line:col"
+  for (int i = 0; i < 2; ++i) {
+    const auto colon = where.rfind(':');
+    if (colon != std::string::npos) where.resize(colon);
+  }
+  const auto candidate = std::filesystem::path(where).parent_path() / p;
+  return std::filesystem::exists(candidate) ? candidate : p;
+}
+
+SolidMesh build_mesh(const ConfigSection& m) {
+  const auto type = m.get<std::string>("type");
+  if (type == "rectangle") {
+    const Eigen::Vector2d origin = vec2(m, "origin");
+    const Eigen::Vector2d size = vec2(m, "size");
+    const auto n = m.get<std::vector<int>>("elements");
+    if (n.size() != 2 || n[0] < 1 || n[1] < 1) m.fail("elements", "must be [nx, ny] with nx, ny >= 1");
+    if (!(size(0) > 0 && size(1) > 0)) m.fail("size", "must be positive");
+    return rectangle_mesh(origin(0), origin(1), size(0), size(1), n[0], n[1]);
+  }
+  if (type == "gmsh") {
+    const auto file = scene_path(m, "file");
+    const auto domain = m.get<std::string>("domain", "");
+#ifdef FSI_HAVE_GMSH_READER
+    try {
+      return mesh_from_gmsh(fsi::read_gmsh(file), domain);
+    } catch (const std::invalid_argument& e) {
+      m.fail("file", e.what());
+    }
+#else
+    m.fail("type", "gmsh meshes need fsi::read_gmsh, not built into fsi_common yet ('" + file.string() + "')");
+#endif
+  }
+  m.fail("type", "must be 'rectangle' or 'gmsh', got '" + type + "'");
+}
+
+}  // namespace
+
+void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
+  auto log = fsi::logger("solid");
+  setup_ = setup;
+
+  // 1. Mesh.
+  mesh_ = build_mesh(s.child("mesh"));
+
+  // 2. Material.
+  const auto mat = s.child("material");
+  const auto law = mat.get<std::string>("law");
+  const double nu = mat.get<double>("poisson_ratio");
+  if (!(nu > -1 && nu < 0.5)) mat.fail("poisson_ratio", "must be in (-1, 0.5)");
+  ElasticConstants constants;
+  const bool has_E = mat.has("youngs_modulus"), has_mu = mat.has("shear_modulus");
+  if (has_E == has_mu) mat.fail(has_E ? "youngs_modulus" : "law", "give exactly one of youngs_modulus or shear_modulus");
+  if (has_E) {
+    const double E = mat.get<double>("youngs_modulus");
+    if (!(E > 0)) mat.fail("youngs_modulus", "must be positive");
+    constants = ElasticConstants::from_youngs(E, nu);
+  } else {
+    const double mu = mat.get<double>("shear_modulus");
+    if (!(mu > 0)) mat.fail("shear_modulus", "must be positive");
+    constants = ElasticConstants::from_shear(mu, nu);
+  }
+  std::shared_ptr<const Material> material;
+  try {
+    material = make_material(law, constants);
+  } catch (const std::invalid_argument& e) {
+    mat.fail("law", e.what());
+  }
+  const double density = s.get<double>("density");
+  if (!(density > 0)) s.fail("density", "must be positive");
+
+  // 3. Analysis type and scheme.
+  const auto analysis = s.get<std::string>("analysis", "dynamic");
+  const auto scheme = s.get<std::string>("time_scheme", "newmark");
+  if (analysis == "static") {
+    scheme_ = TimeScheme::Static;
+  } else if (analysis == "dynamic") {
+    if (scheme == "bdf1") scheme_ = TimeScheme::Bdf1;
+    else if (scheme == "newmark") scheme_ = TimeScheme::Newmark;
+    else s.fail("time_scheme", "must be 'bdf1' or 'newmark', got '" + scheme + "'");
+  } else {
+    s.fail("analysis", "must be 'static' or 'dynamic', got '" + analysis + "'");
+  }
+  load_steps_ = s.get<int>("load_steps", 1);
+  if (load_steps_ < 1) s.fail("load_steps", "must be >= 1");
+
+  // 4. Newton and the linear solver.
+  if (auto n = s.optional_child("newton")) {
+    newton_.max_iterations = n->get<int>("max_iterations", newton_.max_iterations);
+    newton_.residual_tolerance = n->get<double>("residual_tolerance", newton_.residual_tolerance);
+    newton_.increment_tolerance = n->get<double>("increment_tolerance", newton_.increment_tolerance);
+    if (newton_.max_iterations < 1) n->fail("max_iterations", "must be >= 1");
+    if (!(newton_.residual_tolerance > 0)) n->fail("residual_tolerance", "must be positive");
+    if (!(newton_.increment_tolerance >= 0)) n->fail("increment_tolerance", "must be >= 0");
+  }
+  const auto solver_name = s.get<std::string>("linear_solver", "cholmod");
+  LinearSolverKind solver_kind = LinearSolverKind::Cholmod;
+  if (solver_name == "umfpack") solver_kind = LinearSolverKind::Umfpack;
+  else if (solver_name != "cholmod") s.fail("linear_solver", "must be 'cholmod' or 'umfpack'");
+
+  // 5. Clamps (homogeneous Dirichlet on named edges, both components).
+  const auto clamp = names(s, "clamp");
+  std::vector<char> fixed(2 * mesh_.num_nodes(), 0);
+  try {
+    for (int n : mesh_.edge_nodes(clamp)) fixed[2 * n] = fixed[2 * n + 1] = 1;
+  } catch (const std::invalid_argument& e) {
+    s.fail("clamp", e.what());
+  }
+  system_ = std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind);
+
+  // 6. Loads: gravity (force per reference volume rho_s g) and dead edge tractions.
+  const Eigen::Vector2d gravity = vec2(s, "gravity", Eigen::Vector2d::Zero());
+  dead_load_ = system_->body_force(Eigen::Vector2d(density * gravity));
+  for (const auto& t : s.list("tractions")) {
+    const auto boundary = names(t, "boundary");
+    const Eigen::Vector2d traction = vec2(t, "traction");  // force per reference length
+    std::vector<std::array<int, 2>> edges;
+    try {
+      edges = mesh_.edges(boundary);
+    } catch (const std::invalid_argument& e) {
+      t.fail("boundary", e.what());
+    }
+    for (const auto& e : edges) {
+      const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
+      for (int n : e) dead_load_.segment<2>(2 * n) += 0.5 * L * traction;
+    }
+  }
+
+  // 7. Interface: named edges -> InterfaceMeshData; Algorithm 2 damping on them.
+  const auto iface = names(s, "interface");
+  std::vector<std::array<int, 2>> iface_edges;
+  try {
+    iface_edges = mesh_.edges(iface);
+    interface_nodes_ = mesh_.edge_nodes(iface);
+  } catch (const std::invalid_argument& e) {
+    s.fail("interface", e.what());
+  }
+  std::map<int, int> local;
+  for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
+  interface_ = {};
+  interface_.coordinates.resize(static_cast<Eigen::Index>(interface_nodes_.size()), 2);
+  interface_.lumped_measure = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
+  for (std::size_t i = 0; i < interface_nodes_.size(); ++i) {
+    interface_.node_ids.push_back(interface_nodes_[i]);
+    interface_.coordinates.row(static_cast<Eigen::Index>(i)) = mesh_.nodes.row(interface_nodes_[i]);
+  }
+  for (const auto& e : iface_edges) {
+    const int a = local[e[0]], b = local[e[1]];
+    interface_.segments.push_back({a, b});
+    const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
+    interface_.lumped_measure(a) += 0.5 * L;
+    interface_.lumped_measure(b) += 0.5 * L;
+  }
+  if (setup.interface_damping < 0) throw ConfigError("interface damping gamma_N1 must be >= 0");
+  if (setup.interface_damping > 0) {
+    if (iface_edges.empty()) s.fail("interface", "is required when the coupler asks for interface damping");
+    system_->set_damping(system_->boundary_mass(iface_edges, setup.interface_damping));
+  }
+
+  // 8. Probes: displacement of named points, interpolated in the cell that holds them.
+  probes_.clear();
+  for (const auto& p : s.list("probes")) {
+    Probe probe;
+    probe.name = p.get<std::string>("name");
+    probe.point = vec2(p, "point");
+    double best = 1e300;  // the cell whose natural coordinates are closest to [-1, 1]^2
+    for (int c = 0; c < mesh_.num_cells(); ++c) {
+      Eigen::Vector2d xi;
+      if (!q4_inverse_map(system_->cell_coordinates(c), probe.point, xi)) continue;
+      const double outside = xi.cwiseAbs().maxCoeff();
+      if (outside < best) best = outside, probe.cell = c, probe.xi = xi;
+    }
+    if (best > 1 + 1e-6) probe.cell = -1;
+    if (probe.cell < 0) p.fail("point", "is not inside the solid mesh");
+    probes_.push_back(probe);
+  }
+
+  output_every_ = s.get<int>("output_every", 1);
+  if (output_every_ < 0) s.fail("output_every", "must be >= 0 (0 = never)");
+  series_.reset();
+  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid");
+
+  // 9. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
+  const int n = system_->num_dofs();
+  d_n_ = v_n_ = a_n_ = f_n_ = Eigen::VectorXd::Zero(n);
+  if (scheme_ == TimeScheme::Newmark) a_n_ = system_->solve_mass(dead_load_);
+  d_ = d_n_, v_ = v_n_, a_ = a_n_, f_ = f_n_;
+  solved_ = false;
+  log->info("fem solid: {} nodes, {} Q4 cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
+            mesh_.num_nodes(), mesh_.num_cells(), system_->num_free(), material->name(), constants.mu,
+            constants.lambda, analysis, scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
+            setup.interface_damping > 0 ? fmt::format(", interface damping {:.4g}", setup.interface_damping) : "");
+}
+
+Eigen::VectorXd FemSolid::external_force(const Eigen::VectorXd& interface_force) const {
+  Eigen::VectorXd f = dead_load_;
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  if (interface_force.size() == 0) return f;
+  if (interface_force.size() != 2 * n)
+    throw SolverError(fmt::format("solid: interface force has {} entries, expected {} (2 per interface node)",
+                                  interface_force.size(), 2 * n));
+  for (Eigen::Index i = 0; i < n; ++i) f.segment<2>(2 * interface_nodes_[i]) += interface_force.segment<2>(2 * i);
+  return f;
+}
+
+void FemSolid::newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTerms& t, const StepInfo& info) {
+  NewtonReport rep;
+  try {
+    rep = system_->solve(d, f, t, newton_);
+  } catch (const InvertedElement& e) {
+    throw SolverError(fmt::format("solid step {} (t = {:.6g}): element {} inverted (det F = {:.3g})", info.step,
+                                  info.time, e.element, e.det_F));
+  }
+  last_iterations_ += rep.iterations;
+  fsi::logger("solid")->debug("step {} k {}: Newton {} iterations, |R| {:.3e} -> {:.3e}", info.step, info.iteration,
+                              rep.iterations, rep.initial_residual, rep.residual);
+  if (!rep.converged)
+    throw SolverError(fmt::format("solid step {} (t = {:.6g}): Newton did not converge in {} iterations (|R| {:.3e}, "
+                                  "initial {:.3e})",
+                                  info.step, info.time, rep.iterations, rep.residual, rep.initial_residual));
+}
+
+SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) {
+  if (!system_) throw SolverError("solid: solve_step before configure");
+  f_ = external_force(interface_force);
+  last_iterations_ = 0;
+  const double dt = info.dt > 0 ? info.dt : setup_.dt;
+  if (scheme_ != TimeScheme::Static && !(dt > 0)) throw SolverError("solid: dynamic analysis needs dt > 0");
+  if (scheme_ == TimeScheme::Static) {
+    d_ = d_n_;
+    for (int s = 1; s <= load_steps_; ++s) {
+      const Eigen::VectorXd f = f_n_ + (double(s) / load_steps_) * (f_ - f_n_);
+      newton(d_, f, TimeTerms{}, info);
+    }
+    v_.setZero();
+    a_.setZero();
+  } else if (scheme_ == TimeScheme::Bdf1) {
+    TimeTerms t;
+    t.mass_coefficient = 1.0 / (dt * dt);
+    t.acceleration_history = -d_n_ / (dt * dt) - v_n_ / dt;
+    t.damping_coefficient = 1.0 / dt;
+    t.velocity_history = -d_n_ / dt;
+    d_ = d_n_ + dt * v_n_;
+    newton(d_, f_, t, info);
+    v_ = (d_ - d_n_) / dt;
+    a_ = (v_ - v_n_) / dt;
+  } else {
+    const double beta = 0.25, gamma = 0.5;
+    TimeTerms t;
+    t.mass_coefficient = 1.0 / (beta * dt * dt);
+    t.acceleration_history = -(d_n_ + dt * v_n_) / (beta * dt * dt) - (0.5 / beta - 1.0) * a_n_;
+    t.damping_coefficient = gamma * dt * t.mass_coefficient;
+    t.velocity_history = v_n_ + dt * (1 - gamma) * a_n_ + gamma * dt * t.acceleration_history;
+    d_ = d_n_ + dt * v_n_;
+    newton(d_, f_, t, info);
+    a_ = t.mass_coefficient * d_ + t.acceleration_history;
+    v_ = t.damping_coefficient * d_ + t.velocity_history;
+  }
+  solved_ = true;
+  SolidStepResult r;
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  r.interface_displacement.resize(2 * n);
+  r.interface_velocity.resize(2 * n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    r.interface_displacement.segment<2>(2 * i) = d_.segment<2>(2 * interface_nodes_[i]);
+    r.interface_velocity.segment<2>(2 * i) = v_.segment<2>(2 * interface_nodes_[i]);
+  }
+  r.newton_iterations = last_iterations_;
+  return r;
+}
+
+Eigen::Vector2d FemSolid::probe_displacement(const Probe& p, const Eigen::VectorXd& d) const {
+  const Eigen::Vector4d N = q4_shape(p.xi(0), p.xi(1));
+  const auto u = system_->cell_values(p.cell, d);
+  Eigen::Vector2d out = Eigen::Vector2d::Zero();
+  for (int a = 0; a < 4; ++a) out += N(a) * u.segment<2>(2 * a);
+  return out;
+}
+
+std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
+  if (!solved_) throw SolverError(fmt::format("solid: accept_step {} without a solve_step", info.step));
+  d_n_ = d_, v_n_ = v_, a_n_ = a_, f_n_ = f_;
+  solved_ = false;
+  std::map<std::string, double> probes;
+  for (const auto& p : probes_) {
+    const Eigen::Vector2d u = probe_displacement(p, d_n_);
+    probes[p.name + "_x"] = u(0);
+    probes[p.name + "_y"] = u(1);
+  }
+  probes["newton_iterations"] = last_iterations_;
+  return probes;
+}
+
+std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
+  if (!series_ || output_every_ <= 0 || info.step % output_every_ != 0) return {};
+  VtkGrid grid;
+  grid.points = mesh_.nodes;
+  const int nn = mesh_.num_nodes(), nc = mesh_.num_cells();
+  grid.point_data["displacement"] = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(d_n_.data(), nn, 2);
+  grid.point_data["velocity"] = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(v_n_.data(), nn, 2);
+  Eigen::MatrixXd stress(nc, 3);
+  for (int c = 0; c < nc; ++c) {
+    grid.cells.push_back({mesh_.cells[c].begin(), mesh_.cells[c].end()});
+    grid.cell_types.push_back(VtkCellType::Quad);
+    const Matrix2 F = q4_deformation_gradient(system_->cell_coordinates(c), system_->cell_values(c, d_n_), 0, 0);
+    const Kinematics k = Kinematics::from_deformation_gradient(F);
+    stress.row(c) = k.J > 0 ? Eigen::RowVector3d(cauchy_stress(k, system_->material().stress(k)).transpose())
+                            : Eigen::RowVector3d::Constant(NAN);
+  }
+  grid.cell_data["cauchy_stress_xx_yy_xy"] = stress;
+  return {series_->write(info.time, info.step, grid).string()};
+}
+
+}  // namespace fsi::solid

@@ -1,0 +1,289 @@
+#include "fsi/solid/solid_system.hpp"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCholesky>
+#include <Eigen/UmfPackSupport>
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "fsi/common/log.hpp"
+#include "fsi/common/solver_model.hpp"
+#include "fsi/solid/element.hpp"
+
+namespace fsi::solid {
+
+// ---------------------------------------------------------------- linear solver
+struct SparseDirectSolver::Impl {
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholmod;
+  Eigen::UmfPackLU<SparseMatrix> umfpack;
+  bool analysed = false;
+};
+
+SparseDirectSolver::SparseDirectSolver(LinearSolverKind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {
+  // Inside Newton the iterative refinement of UMFPACK is not worth its cost.
+  impl_->umfpack.umfpackControl()(UMFPACK_IRSTEP) = 0;
+}
+SparseDirectSolver::~SparseDirectSolver() = default;
+SparseDirectSolver::SparseDirectSolver(SparseDirectSolver&&) noexcept = default;
+SparseDirectSolver& SparseDirectSolver::operator=(SparseDirectSolver&&) noexcept = default;
+
+void SparseDirectSolver::factorize(const SparseMatrix& A) {
+  if (kind_ == LinearSolverKind::Cholmod) {
+    if (!impl_->analysed) impl_->cholmod.analyzePattern(A), impl_->analysed = true;
+    impl_->cholmod.factorize(A);
+    if (impl_->cholmod.info() == Eigen::Success) return;
+    fsi::logger("solid")->warn("CHOLMOD: tangent not positive definite; switching to UMFPACK");
+    kind_ = LinearSolverKind::Umfpack;
+    impl_->analysed = false;
+  }
+  if (!impl_->analysed) impl_->umfpack.analyzePattern(A), impl_->analysed = true;
+  impl_->umfpack.factorize(A);
+  if (impl_->umfpack.info() != Eigen::Success) throw fsi::SolverError("UMFPACK: singular tangent matrix");
+}
+
+Eigen::VectorXd SparseDirectSolver::solve(const Eigen::VectorXd& b) const {
+  if (kind_ == LinearSolverKind::Cholmod) return impl_->cholmod.solve(b);
+  return impl_->umfpack.solve(b);
+}
+
+// ---------------------------------------------------------------- system
+InvertedElement::InvertedElement(int e, double det)
+    : std::runtime_error("element " + std::to_string(e) + ": det F = " + std::to_string(det) + " <= 0"),
+      element(e),
+      det_F(det) {}
+
+SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> material, double density,
+                         std::vector<char> fixed_dofs, LinearSolverKind solver)
+    : mesh_(mesh), material_(std::move(material)), density_(density), fixed_(std::move(fixed_dofs)), solver_(solver) {
+  const int n = num_dofs();
+  if (static_cast<int>(fixed_.size()) != n) throw std::invalid_argument("SolidSystem: fixed flags must have one entry per dof");
+  equation_.assign(n, -1);
+  for (int i = 0; i < n; ++i)
+    if (!fixed_[i]) equation_[i] = static_cast<int>(free_dofs_.size()), free_dofs_.push_back(i);
+
+  for (int c = 0; c < mesh_.num_cells(); ++c) {
+    const auto X = cell_coordinates(c);
+    double area2 = 0;
+    for (int a = 0; a < 4; ++a) area2 += X(a, 0) * X((a + 1) % 4, 1) - X((a + 1) % 4, 0) * X(a, 1);
+    if (!(area2 > 0)) throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
+  }
+
+  // Full pattern from the cell connectivity.
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(64 * mesh_.cells.size());
+  for (const auto& cell : mesh_.cells)
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) trip.emplace_back(2 * cell[a / 2] + a % 2, 2 * cell[b / 2] + b % 2, 0.0);
+  pattern_.resize(n, n);
+  pattern_.setFromTriplets(trip.begin(), trip.end());
+  pattern_.makeCompressed();
+
+  cell_positions_.resize(64 * mesh_.cells.size());
+  for (std::size_t c = 0; c < mesh_.cells.size(); ++c) {
+    const auto& cell = mesh_.cells[c];
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b)
+        cell_positions_[64 * c + 8 * a + b] = position(2 * cell[a / 2] + a % 2, 2 * cell[b / 2] + b % 2);
+  }
+
+  // Reduced pattern and the value map.
+  std::vector<Eigen::Triplet<double>> rtrip;
+  for (int col = 0; col < n; ++col)
+    for (SparseMatrix::InnerIterator it(pattern_, col); it; ++it)
+      if (equation_[it.row()] >= 0 && equation_[col] >= 0) rtrip.emplace_back(equation_[it.row()], equation_[col], 0.0);
+  reduced_pattern_.resize(num_free(), num_free());
+  reduced_pattern_.setFromTriplets(rtrip.begin(), rtrip.end());
+  reduced_pattern_.makeCompressed();
+  full_to_reduced_.assign(pattern_.nonZeros(), -1);
+  for (int col = 0; col < n; ++col)
+    for (SparseMatrix::InnerIterator it(pattern_, col); it; ++it) {
+      const int r = equation_[it.row()], c = equation_[col];
+      if (r < 0 || c < 0) continue;
+      const int* begin = reduced_pattern_.innerIndexPtr() + reduced_pattern_.outerIndexPtr()[c];
+      const int* end = reduced_pattern_.innerIndexPtr() + reduced_pattern_.outerIndexPtr()[c + 1];
+      full_to_reduced_[&it.valueRef() - pattern_.valuePtr()] =
+          static_cast<int>(std::lower_bound(begin, end, r) - reduced_pattern_.innerIndexPtr());
+    }
+
+  mass_ = pattern_;
+  for (int c = 0; c < mesh_.num_cells(); ++c) {
+    const ElementMatrix Me = q4_mass(cell_coordinates(c), density_);
+    for (int k = 0; k < 64; ++k) mass_.valuePtr()[cell_positions_[64 * c + k]] += Me(k / 8, k % 8);
+  }
+  damping_ = pattern_;
+}
+
+int SolidSystem::position(int row, int col) const {
+  const int* begin = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col];
+  const int* end = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(begin, end, row);
+  if (it == end || *it != row) throw std::invalid_argument("entry outside the mesh's sparsity pattern");
+  return static_cast<int>(it - pattern_.innerIndexPtr());
+}
+
+Eigen::Matrix<double, 4, 2> SolidSystem::cell_coordinates(int c) const {
+  Eigen::Matrix<double, 4, 2> X;
+  for (int a = 0; a < 4; ++a) X.row(a) = mesh_.nodes.row(mesh_.cells[c][a]);
+  return X;
+}
+
+Eigen::Matrix<double, 8, 1> SolidSystem::cell_values(int c, const Eigen::VectorXd& d) const {
+  Eigen::Matrix<double, 8, 1> u;
+  for (int a = 0; a < 4; ++a) u.segment<2>(2 * a) = d.segment<2>(2 * mesh_.cells[c][a]);
+  return u;
+}
+
+SparseMatrix SolidSystem::boundary_mass(const std::vector<std::array<int, 2>>& edges, double weight) const {
+  SparseMatrix C = pattern_;
+  for (const auto& e : edges) {
+    const Eigen::Matrix4d Me = edge_mass(mesh_.nodes.row(e[0]).transpose(), mesh_.nodes.row(e[1]).transpose(), weight);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        C.valuePtr()[position(2 * e[a / 2] + a % 2, 2 * e[b / 2] + b % 2)] += Me(a, b);
+  }
+  return C;
+}
+
+void SolidSystem::set_damping(SparseMatrix damping) {
+  if (damping.rows() != num_dofs() || damping.nonZeros() != pattern_.nonZeros())
+    throw std::invalid_argument("set_damping: matrix must be built on the system's pattern (boundary_mass)");
+  damping_ = std::move(damping);
+}
+
+Eigen::VectorXd SolidSystem::body_force(const Eigen::Vector2d& b) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
+  for (int c = 0; c < mesh_.num_cells(); ++c) {
+    const ElementVector fe = q4_body_force(cell_coordinates(c), b);
+    for (int a = 0; a < 4; ++a) f.segment<2>(2 * mesh_.cells[c][a]) += fe.segment<2>(2 * a);
+  }
+  return f;
+}
+
+Eigen::VectorXd SolidSystem::body_force(const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& b,
+                                        int gauss) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
+  const auto rule = gauss_rule_2d(gauss);
+  for (int c = 0; c < mesh_.num_cells(); ++c) {
+    const auto X = cell_coordinates(c);
+    for (const auto& [xi, eta, w] : rule) {
+      const Eigen::Vector4d N = q4_shape(xi, eta);
+      const double dV = w * (X.transpose() * q4_shape_derivatives(xi, eta)).determinant();
+      const Eigen::Vector2d bx = b(X.transpose() * N);
+      for (int a = 0; a < 4; ++a) f.segment<2>(2 * mesh_.cells[c][a]) += dV * N(a) * bx;
+    }
+  }
+  return f;
+}
+
+Eigen::VectorXd SolidSystem::internal_force(const Eigen::VectorXd& d) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
+  for (int c = 0; c < mesh_.num_cells(); ++c) {
+    const ElementState s = q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, false);
+    if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
+    for (int a = 0; a < 4; ++a) f.segment<2>(2 * mesh_.cells[c][a]) += s.internal_force.segment<2>(2 * a);
+  }
+  return f;
+}
+
+namespace {
+Eigen::VectorXd time_vector(double coef, const Eigen::VectorXd& d, const Eigen::VectorXd& hist) {
+  Eigen::VectorXd v = coef * d;
+  if (hist.size()) v += hist;
+  return v;
+}
+}  // namespace
+
+Eigen::VectorXd SolidSystem::residual(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t) const {
+  Eigen::VectorXd r = internal_force(d) - f_ext;
+  if (t.mass_coefficient != 0 || t.acceleration_history.size())
+    r += mass_ * time_vector(t.mass_coefficient, d, t.acceleration_history);
+  if (damping_.nonZeros() && (t.damping_coefficient != 0 || t.velocity_history.size()))
+    r += damping_ * time_vector(t.damping_coefficient, d, t.velocity_history);
+  return r;
+}
+
+void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t,
+                           SparseMatrix& K, Eigen::VectorXd& r_free) const {
+  if (K.nonZeros() != reduced_pattern_.nonZeros()) K = reduced_pattern_;
+  std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
+  Eigen::VectorXd r = -f_ext;
+  double* values = K.valuePtr();
+  for (int c = 0; c < mesh_.num_cells(); ++c) {
+    const ElementState s = q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, true);
+    if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
+    for (int a = 0; a < 4; ++a) r.segment<2>(2 * mesh_.cells[c][a]) += s.internal_force.segment<2>(2 * a);
+    const int* pos = &cell_positions_[64 * c];
+    for (int k = 0; k < 64; ++k) {
+      const int red = full_to_reduced_[pos[k]];
+      if (red >= 0) values[red] += s.tangent(k / 8, k % 8);
+    }
+  }
+  auto add_scaled = [&](const SparseMatrix& A, double coef) {
+    if (coef == 0) return;
+    for (Eigen::Index i = 0; i < A.nonZeros(); ++i)
+      if (full_to_reduced_[i] >= 0) values[full_to_reduced_[i]] += coef * A.valuePtr()[i];
+  };
+  add_scaled(mass_, t.mass_coefficient);
+  add_scaled(damping_, t.damping_coefficient);
+  if (t.mass_coefficient != 0 || t.acceleration_history.size())
+    r += mass_ * time_vector(t.mass_coefficient, d, t.acceleration_history);
+  if (t.damping_coefficient != 0 || t.velocity_history.size())
+    r += damping_ * time_vector(t.damping_coefficient, d, t.velocity_history);
+  r_free.resize(num_free());
+  for (int i = 0; i < num_free(); ++i) r_free(i) = r(free_dofs_[i]);
+}
+
+NewtonReport SolidSystem::solve(Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t,
+                                const NewtonOptions& options) {
+  NewtonReport rep;
+  SparseMatrix K;
+  Eigen::VectorXd r;
+  double f_norm = 0;
+  for (int i = 0; i < num_free(); ++i) f_norm += f_ext(free_dofs_[i]) * f_ext(free_dofs_[i]);
+  f_norm = std::sqrt(f_norm);
+  for (int it = 0; it <= options.max_iterations; ++it) {
+    assemble(d, f_ext, t, K, r);
+    rep.residual = r.norm();
+    if (it == 0) rep.initial_residual = rep.residual;
+    const double ref = std::max(rep.initial_residual, f_norm);
+    if (rep.residual <= options.residual_tolerance * ref || rep.residual == 0) {
+      rep.converged = true;
+      return rep;
+    }
+    if (it == options.max_iterations) break;
+    solver_.factorize(K);
+    const Eigen::VectorXd dd = solver_.solve(-r);
+    if (!dd.allFinite()) break;
+    double d_norm = 0;
+    for (int i = 0; i < num_free(); ++i) {
+      d(free_dofs_[i]) += dd(i);
+      d_norm += d(free_dofs_[i]) * d(free_dofs_[i]);
+    }
+    rep.iterations = it + 1;
+    if (dd.norm() <= options.increment_tolerance * std::sqrt(d_norm)) {
+      // Increment negligible: accept after one more residual evaluation.
+      assemble(d, f_ext, t, K, r);
+      rep.residual = r.norm();
+      rep.converged = rep.residual <= std::sqrt(options.residual_tolerance) * std::max(rep.initial_residual, f_norm);
+      return rep;
+    }
+  }
+  return rep;
+}
+
+Eigen::VectorXd SolidSystem::solve_mass(const Eigen::VectorXd& b) const {
+  SparseMatrix Mff = reduced_pattern_;
+  for (Eigen::Index i = 0; i < mass_.nonZeros(); ++i)
+    if (full_to_reduced_[i] >= 0) Mff.valuePtr()[full_to_reduced_[i]] += mass_.valuePtr()[i];
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(Mff);
+  if (ldlt.info() != Eigen::Success) throw fsi::SolverError("mass matrix factorisation failed");
+  Eigen::VectorXd bf(num_free());
+  for (int i = 0; i < num_free(); ++i) bf(i) = b(free_dofs_[i]);
+  const Eigen::VectorXd xf = ldlt.solve(bf);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(num_dofs());
+  for (int i = 0; i < num_free(); ++i) x(free_dofs_[i]) = xf(i);
+  return x;
+}
+
+}  // namespace fsi::solid
