@@ -92,13 +92,20 @@ bool Scene::has(const std::string& dotted_key) const {
   YAML::Node node = state_->root;
   for (const auto& part : split_dotted(dotted_key)) {
     if (!node.IsMap()) return false;
-    node = node[part];
-    if (!node) return false;
+    const YAML::Node next = node[part];  // note: Node::operator= would assign, not rebind
+    if (!next) return false;
+    node.reset(next);
   }
   return true;
 }
 
 ConfigSection Scene::root() const { return ConfigSection(state_, state_->root, ""); }
+
+std::string Scene::name() const {
+  const auto r = root();
+  r.get<std::string>("description", "");  // documentation only
+  return r.get<std::string>("scene", "");
+}
 
 ConfigSection Scene::section(const std::string& name) const { return root().child(name); }
 
@@ -106,8 +113,12 @@ void Scene::check_all_used(const std::string& prefix) const {
   std::vector<std::string> unknown;
   YAML::Node node = state_->root;
   if (!prefix.empty()) {
-    for (const auto& part : split_dotted(prefix)) node = node[part];
-    if (!node) return;
+    for (const auto& part : split_dotted(prefix)) {
+      if (!node.IsMap()) return;
+      const YAML::Node next = node[part];
+      if (!next) return;
+      node.reset(next);
+    }
     if (!state_->used.count(prefix)) {
       throw ConfigError("section '" + prefix + "' in " + state_->origin + " was not read");
     }
@@ -175,6 +186,17 @@ std::vector<ConfigSection> ConfigSection::list(const std::string& key) const {
     items.emplace_back(state_, value[i], item_path);
   }
   return items;
+}
+
+std::filesystem::path ConfigSection::scene_dir() const {
+  std::filesystem::path origin(state_->origin);
+  return origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");
+}
+
+std::filesystem::path ConfigSection::get_path(const std::string& key) const {
+  std::filesystem::path p(get<std::string>(key));
+  if (p.is_absolute()) return p;
+  return scene_dir() / p;
 }
 
 std::vector<std::string> ConfigSection::keys() const {

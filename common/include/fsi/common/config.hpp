@@ -40,7 +40,10 @@ class Scene {
   const std::string& text() const { return state_->text; }
   const std::vector<std::string>& overrides() const { return state_->overrides; }
   bool has(const std::string& dotted_key) const;
+  // The scene's `scene` name (also marks `scene` and `description` as read).
+  std::string name() const;
   ConfigSection root() const;
+  const YAML::Node& root_node() const { return state_->root; }
   ConfigSection section(const std::string& name) const;  // required map
   // Throws ConfigError listing every key under `prefix` ("" = whole file) never read.
   void check_all_used(const std::string& prefix = "") const;
@@ -71,6 +74,14 @@ class ConfigSection {
   std::vector<ConfigSection> list(const std::string& key) const;  // sequence of maps
   std::vector<std::string> keys() const;
   const std::string& path() const { return path_; }
+  // The scene this section belongs to (a remote solver is sent the whole text).
+  const std::string& scene_text() const { return state_->text; }
+  const std::string& scene_origin() const { return state_->origin; }
+  const std::vector<std::string>& scene_overrides() const { return state_->overrides; }
+  // Directory of the scene file, for resolving relative paths (mesh files).
+  std::filesystem::path scene_dir() const;
+  // Resolves a path key: absolute, or relative to the scene file's directory.
+  std::filesystem::path get_path(const std::string& key) const;
   std::string where(const std::string& key) const;  // "file:line:col" of a key
   std::string full_key(const std::string& key) const;
   // An error that names the key and its place, e.g. for a value out of range.

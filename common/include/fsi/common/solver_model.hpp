@@ -32,6 +32,8 @@ struct InterfaceMeshData {
   Eigen::MatrixX2d coordinates;                // reference configuration, n x 2
   std::vector<std::array<int, 2>> segments;    // local indices; empty for a point interface
   Eigen::VectorXd lumped_measure;              // used when segments is empty (size n)
+  Eigen::VectorXd initial_displacement;        // 2n, or empty = zero
+  Eigen::VectorXd initial_velocity;            // 2n, or empty = zero
   std::size_t nodes() const { return static_cast<std::size_t>(coordinates.rows()); }
 };
 

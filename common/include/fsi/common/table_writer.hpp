@@ -12,6 +12,8 @@ class CsvWriter {
  public:
   CsvWriter() = default;
   CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns);
+  CsvWriter(CsvWriter&&) = default;
+  CsvWriter& operator=(CsvWriter&&) = default;
   bool is_open() const { return out_.is_open(); }
   std::size_t columns() const { return columns_; }
   // Writes one row; throws std::invalid_argument if its size differs from the header's.

@@ -1,0 +1,45 @@
+#pragma once
+// Runs one solver alone from a scene (no coupler, no other process): the CSM benchmarks
+// (solid alone) and the DFG/CFD benchmarks (fluid alone). Writes summary.json and
+// probes.csv into `out_dir` step by step, logs progress with an ETA.
+#include <filesystem>
+#include <functional>
+#include <memory>
+
+#include "fsi/common/config.hpp"
+#include "fsi/common/solver_model.hpp"
+
+namespace fsi {
+
+using SolidFactory = std::function<std::unique_ptr<SolidModel>(const std::string& model)>;
+using FluidFactory = std::function<std::unique_ptr<FluidModel>(const std::string& model)>;
+
+// Both build the model named by `<section>.model`, configure it (unknown keys anywhere in
+// the scene are an error), run every step with a zero interface load, and return the
+// process exit code (0 completed, 1 failed/diverged) after writing the summary.
+int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir);
+int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir);
+
+// Time section shared by all runners: `time: {dt: ..., end: ..., output_every: N}`.
+struct TimeSettings {
+  double dt = 0;
+  double end = 0;
+  int steps = 0;          // round(end / dt)
+  int output_every = 0;   // write VTK every N steps (0 = never)
+};
+TimeSettings read_time(const Scene& scene);
+
+// Progress line every few seconds: step, time, extra text, ETA.
+class Progress {
+ public:
+  Progress(std::string logger_name, int total_steps);
+  void update(int step, double time, const std::string& extra = "");
+
+ private:
+  std::string logger_name_;
+  int total_;
+  double start_;
+  double last_ = -1e9;
+};
+
+}  // namespace fsi

@@ -1,0 +1,89 @@
+#include "fsi/common/run_report.hpp"
+
+#include <fstream>
+
+namespace fsi {
+namespace {
+
+nlohmann::json yaml_to_json(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Map: {
+      nlohmann::json j = nlohmann::json::object();
+      for (const auto& kv : node) j[kv.first.Scalar()] = yaml_to_json(kv.second);
+      return j;
+    }
+    case YAML::NodeType::Sequence: {
+      nlohmann::json j = nlohmann::json::array();
+      for (const auto& item : node) j.push_back(yaml_to_json(item));
+      return j;
+    }
+    case YAML::NodeType::Scalar: {
+      const std::string& s = node.Scalar();
+      if (s == "true" || s == "false") return s == "true";
+      try {
+        std::size_t used = 0;
+        const long long i = std::stoll(s, &used);
+        if (used == s.size()) return i;
+      } catch (...) {
+      }
+      try {
+        std::size_t used = 0;
+        const double d = std::stod(s, &used);
+        if (used == s.size()) return d;
+      } catch (...) {
+      }
+      return s;
+    }
+    default:
+      return nullptr;
+  }
+}
+
+}  // namespace
+
+nlohmann::json scene_to_json(const Scene& scene) { return yaml_to_json(YAML::Load(YAML::Dump(scene.root_node()))); }
+
+RunReport::RunReport(std::filesystem::path out_dir, const Scene& scene, std::string runner)
+    : out_dir_(std::move(out_dir)) {
+  std::filesystem::create_directories(out_dir_);
+  data_["scene_file"] = scene.origin();
+  data_["overrides"] = scene.overrides();
+  data_["runner"] = runner;
+  data_["parameters"] = scene_to_json(scene);
+  data_["scene"] = data_["parameters"].value("scene", std::string(""));
+  data_["status"] = "running";
+  data_["reason"] = "";
+}
+
+void RunReport::set_status(const std::string& status, const std::string& reason) {
+  data_["status"] = status;
+  data_["reason"] = reason;
+}
+
+void RunReport::write() const {
+  const auto tmp = out_dir_ / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << data_.dump(2) << '\n';
+  }
+  std::filesystem::rename(tmp, out_dir_ / "summary.json");
+}
+
+void ProbeTable::add(double time, const std::map<std::string, double>& probes) {
+  if (!csv_.is_open()) {
+    std::vector<std::string> header{"time"};
+    for (const auto& [name, value] : probes) {
+      names_.push_back(name);
+      header.push_back(name);
+    }
+    csv_ = CsvWriter(path_, header);
+  }
+  std::vector<double> row{time};
+  for (const auto& name : names_) {
+    auto it = probes.find(name);
+    row.push_back(it == probes.end() ? std::nan("") : it->second);
+  }
+  csv_.row(row);
+}
+
+}  // namespace fsi

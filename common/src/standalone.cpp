@@ -1,0 +1,144 @@
+#include "fsi/common/standalone.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "fsi/common/log.hpp"
+#include "fsi/common/run_report.hpp"
+
+namespace fsi {
+namespace {
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+template <class Model, class SetupFn, class StepFn>
+int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::filesystem::path& out_dir,
+             const char* runner, const char* section, SetupFn&& setup_fn, StepFn&& step_fn,
+             double& compute_time) {
+  auto log = logger(runner);
+  RunReport report(out_dir, scene, runner);
+  const double start = now_seconds();
+  int steps_done = 0;
+  try {
+    scene.name();
+    const TimeSettings time = read_time(scene);
+    setup_fn(time);
+    ProbeTable probes(out_dir / "probes.csv");
+    Progress progress(runner, time.steps);
+    for (int n = 1; n <= time.steps; ++n) {
+      StepInfo info{n * time.dt, time.dt, n, 0};
+      const double t0 = now_seconds();
+      auto values = step_fn(info);
+      compute_time += now_seconds() - t0;
+      for (const auto& [k, v] : values)
+        if (!std::isfinite(v))
+          throw SolverError(fmt::format("probe '{}' is not finite at step {} (t = {})", k, n, info.time));
+      std::map<std::string, double> named;
+      for (const auto& [k, v] : values) named[std::string(section) + "." + k] = v;
+      probes.add(info.time, named);
+      if (time.output_every > 0 && n % time.output_every == 0) model->write_output(info);
+      steps_done = n;
+      report.data()["steps"] = steps_done;
+      if (n == time.steps || n % 10 == 0) {
+        report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
+        report.write();
+      }
+      progress.update(n, info.time);
+    }
+    report.set_status("completed");
+    report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
+  } catch (const ConfigError& e) {
+    report.set_status("failed", std::string("configuration: ") + e.what());
+  } catch (const SolverError& e) {
+    report.set_status("diverged", fmt::format("{} solver failed at step {}: {}", section, steps_done + 1, e.what()));
+  } catch (const std::exception& e) {
+    report.set_status("failed", e.what());
+  }
+  report.data()["steps"] = steps_done;
+  report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
+  report.write();
+  const std::string status = report.data()["status"];
+  if (status != "completed") {
+    log->error("{}: {}", status, report.data()["reason"].get<std::string>());
+    return 1;
+  }
+  log->info("completed {} steps in {:.2f} s; results in {}", steps_done, now_seconds() - start, out_dir.string());
+  return 0;
+}
+
+}  // namespace
+
+TimeSettings read_time(const Scene& scene) {
+  const auto t = scene.section("time");
+  TimeSettings s;
+  s.dt = t.get<double>("dt");
+  s.end = t.get<double>("end");
+  s.output_every = t.get<int>("output_every", 0);
+  if (!(s.dt > 0)) t.fail("dt", "must be positive");
+  if (!(s.end > 0)) t.fail("end", "must be positive");
+  if (s.output_every < 0) t.fail("output_every", "must be >= 0");
+  s.steps = static_cast<int>(std::llround(s.end / s.dt));
+  if (s.steps < 1) t.fail("end", "is shorter than one time step");
+  return s;
+}
+
+Progress::Progress(std::string logger_name, int total_steps)
+    : logger_name_(std::move(logger_name)), total_(total_steps), start_(now_seconds()) {}
+
+void Progress::update(int step, double time, const std::string& extra) {
+  const double now = now_seconds();
+  if (now - last_ < 2.0 && step != total_) return;
+  last_ = now;
+  const double elapsed = now - start_;
+  const double eta = step > 0 ? elapsed / step * (total_ - step) : 0.0;
+  logger(logger_name_)->info("step {}/{} t={:.5g} {} elapsed {:.1f} s, ETA {:.1f} s", step, total_, time, extra,
+                             elapsed, eta);
+}
+
+int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir) {
+  double compute = 0;
+  std::unique_ptr<SolidModel> model;
+  return run_loop(
+      model, scene, out_dir, "solid_server", "solid",
+      [&](const TimeSettings& time) {
+        const auto section = scene.section("solid");
+        const auto kind = section.get<std::string>("model");
+        model = factory(kind);
+        if (!model) section.fail("model", "names no solid model this server knows ('" + kind + "')");
+        model->configure(section, SolidSetup{time.dt, time.end, 0.0, out_dir / "vtk"});
+        scene.check_all_used();
+      },
+      [&](const StepInfo& info) {
+        const auto n = model->interface().nodes();
+        model->solve_step(info, Eigen::VectorXd::Zero(2 * n));
+        return model->accept_step(info);
+      },
+      compute);
+}
+
+int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir) {
+  double compute = 0;
+  std::unique_ptr<FluidModel> model;
+  return run_loop(
+      model, scene, out_dir, "fluid_server", "fluid",
+      [&](const TimeSettings& time) {
+        const auto section = scene.section("fluid");
+        const auto kind = section.get<std::string>("model");
+        model = factory(kind);
+        if (!model) section.fail("model", "names no fluid model this server knows ('" + kind + "')");
+        model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0, out_dir / "vtk"});
+        scene.check_all_used();
+      },
+      [&](const StepInfo& info) {
+        const auto n = model->interface().nodes();
+        model->solve_step(info, Eigen::VectorXd::Zero(2 * n), Eigen::VectorXd::Zero(2 * n));
+        return model->accept_step(info);
+      },
+      compute);
+}
+
+}  // namespace fsi

@@ -1,0 +1,68 @@
+#pragma once
+// The coupler's time loop: the seed paper's Algorithms 1 and 2 with the force predictor,
+// constant relaxation and a fixed number of iterations or a residual tolerance.
+//
+// Per step n -> n+1 (F_n = the last relaxed force of step n; F_0 = -F* of the initial state):
+//   F^(1) = F_n (predictor)
+//   for k = 1..k_max:
+//     solid:  M a + [M_fs v] + F_int(d) = F^(k)         ([M_fs v] for Algorithm 2 only)
+//     fluid:  mesh <- H d_s, Nitsche velocity <- H v_s  -> f_sigma, f_v (mapped back by H^T)
+//     F*  = f_sigma + gamma (M_G v_s - f_v)    (Algorithm 1)
+//     F*  = f_sigma - gamma f_v                (Algorithm 2)
+//     F^(k+1) = -beta F* + (1 - beta) F^(k)
+//   accept both; F_{n+1} = F^(k+1)
+//
+// Usage: Coupler c(solid, fluid, scene, out_dir); RunOutcome r = c.run();
+// The models may be in-process (tests) or remote proxies (protocol/remote.hpp).
+#include <Eigen/Core>
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+
+#include "fsi/common/config.hpp"
+#include "fsi/common/run_report.hpp"
+#include "fsi/common/solver_model.hpp"
+#include "fsi/coupling/interface_map.hpp"
+#include "fsi/coupling/settings.hpp"
+
+namespace fsi::coupling {
+
+struct RunOutcome {
+  std::string status = "running";  // completed / diverged / failed
+  std::string reason;
+  int steps = 0;
+  long iterations = 0;
+  int exit_code() const { return status == "completed" ? 0 : status == "diverged" ? 2 : 1; }
+};
+
+struct CouplerTimes {
+  double total = 0, solid = 0, fluid = 0, coupler = 0;  // wall seconds
+};
+
+class Coupler {
+ public:
+  Coupler(SolidModel& solid, FluidModel& fluid, const Scene& scene, std::filesystem::path out_dir);
+  // Runs the whole scene. Never throws for a run-time failure: the outcome says why.
+  // Writes probes.csv and iterations.csv row by row; fills `report` (summary.json).
+  RunOutcome run(RunReport& report);
+  const CouplerTimes& times() const { return times_; }
+  // Set from a signal handler to stop between iterations.
+  static std::atomic<bool>& interrupt_flag();
+  // Called after each accepted step (for progress/summary refresh by the app).
+  std::function<void(const RunOutcome&)> on_step;
+
+ private:
+  Eigen::VectorXd robin_force(const Eigen::VectorXd& traction, const Eigen::VectorXd& velocity_integral,
+                              const Eigen::VectorXd& solid_velocity, const Eigen::VectorXd& solid_displacement) const;
+  SolidModel& solid_;
+  FluidModel& fluid_;
+  const Scene& scene_;
+  std::filesystem::path out_dir_;
+  CouplingSettings settings_;
+  InterfaceMeshData solid_interface_;
+  InterfaceMap map_;
+  CouplerTimes times_;
+};
+
+}  // namespace fsi::coupling

@@ -1,0 +1,241 @@
+#include "fsi/coupling/coupler.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "fsi/common/log.hpp"
+#include "fsi/common/standalone.hpp"
+#include "fsi/common/table_writer.hpp"
+
+namespace fsi::coupling {
+namespace {
+
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+// Adds wall time of a scope to an accumulator.
+class Timer {
+ public:
+  explicit Timer(double& acc) : acc_(acc), start_(now()) {}
+  ~Timer() { acc_ += now() - start_; }
+
+ private:
+  double& acc_;
+  double start_;
+};
+
+bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
+
+// A run-time stop with its classification.
+struct Stop {
+  std::string status, reason;
+};
+
+}  // namespace
+
+std::atomic<bool>& Coupler::interrupt_flag() {
+  static std::atomic<bool> flag{false};
+  return flag;
+}
+
+Coupler::Coupler(SolidModel& solid, FluidModel& fluid, const Scene& scene, std::filesystem::path out_dir)
+    : solid_(solid), fluid_(fluid), scene_(scene), out_dir_(std::move(out_dir)) {}
+
+Eigen::VectorXd Coupler::robin_force(const Eigen::VectorXd& traction, const Eigen::VectorXd& velocity_integral,
+                                     const Eigen::VectorXd& solid_velocity,
+                                     const Eigen::VectorXd& solid_displacement) const {
+  const double gamma = settings_.nitsche_penalty;
+  if (settings_.algorithm == Algorithm::ImplicitSolidVelocity) return traction - gamma * velocity_integral;
+  if (gamma == 0) return traction;
+  const Eigen::SparseMatrix<double> mg = interface_mass(solid_interface_, solid_displacement);
+  return traction + gamma * (mg * solid_velocity - velocity_integral);
+}
+
+RunOutcome Coupler::run(RunReport& report) {
+  auto log = logger("coupler");
+  RunOutcome out;
+  const double start = now();
+  double& solid_time = times_.solid;
+  double& fluid_time = times_.fluid;
+  double& coupler_time = times_.coupler;
+  auto& data = report.data();
+  try {
+    // 1. Read the scene's coupling part; configure both solvers.
+    scene_.name();
+    const TimeSettings time = read_time(scene_);
+    settings_ = read_coupling(scene_.section("coupling"));
+    scene_.check_all_used("coupling");
+    scene_.check_all_used("time");
+    for (const auto& key : scene_.root().keys())
+      if (key != "scene" && key != "description" && key != "time" && key != "coupling" && key != "solid" &&
+          key != "fluid")
+        throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
+                                      "coupling, solid, fluid)", scene_.root().where(key), key));
+    const double gamma = settings_.nitsche_penalty;
+    const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
+    if (implicit && gamma > 0 && !solid_.supports_interface_damping())
+      throw Stop{"failed", fmt::format("Algorithm 2 needs interface damping, which solid '{}' does not support",
+                                       solid_.name())};
+    const auto vtk_dir = out_dir_ / "vtk";
+    {
+      Timer t(solid_time);
+      solid_.configure(scene_.section("solid"), SolidSetup{time.dt, time.end, implicit ? gamma : 0.0,
+                                                           time.output_every > 0 ? vtk_dir : std::filesystem::path()});
+    }
+    {
+      Timer t(fluid_time);
+      fluid_.configure(scene_.section("fluid"),
+                       FluidSetup{time.dt, time.end, gamma, settings_.nitsche_symmetry,
+                                  time.output_every > 0 ? vtk_dir : std::filesystem::path()});
+    }
+    solid_interface_ = solid_.interface();
+    const InterfaceMeshData fluid_interface = fluid_.interface();
+    {
+      Timer t(coupler_time);
+      map_ = InterfaceMap(solid_interface_, fluid_interface);
+    }
+    const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
+    data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
+                         {"max_gap", map_.max_gap()}};
+    data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
+                        {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
+                        {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance}};
+    log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
+              to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
+              settings_.tolerance, ns, fluid_interface.nodes());
+
+    // 2. Initial state and the predictor's F_0 = -F*(initial fluid state).
+    Eigen::VectorXd d_s = solid_interface_.initial_displacement.size() == 2 * ns
+                              ? solid_interface_.initial_displacement
+                              : Eigen::VectorXd::Zero(2 * ns);
+    Eigen::VectorXd v_s = solid_interface_.initial_velocity.size() == 2 * ns ? solid_interface_.initial_velocity
+                                                                              : Eigen::VectorXd::Zero(2 * ns);
+    Eigen::VectorXd force_n, force_nm1;
+    {
+      FluidLoads loads;
+      {
+        Timer t(fluid_time);
+        loads = fluid_.initial_loads(map_.to_fluid(d_s), map_.to_fluid(v_s));
+      }
+      Timer t(coupler_time);
+      force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s);
+    }
+    force_nm1 = force_n;
+
+    // 3. Time loop.
+    ProbeTable probes(out_dir_ / "probes.csv");
+    CsvWriter iterations(out_dir_ / "iterations.csv",
+                         {"step", "time", "iteration", "residual", "force_norm", "solid_newton", "fluid_iterations"});
+    Progress progress("coupler", time.steps);
+    for (int n = 1; n <= time.steps; ++n) {
+      const double t_np1 = n * time.dt;
+      Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * force_n - force_nm1)
+                                                                               : force_n;
+      double first_residual = 0, residual = 0;
+      bool converged = settings_.tolerance == 0;
+      int k = 1;
+      for (; k <= settings_.max_iterations; ++k) {
+        if (interrupt_flag()) throw Stop{"failed", fmt::format("interrupted at step {} iteration {}", n, k)};
+        const StepInfo info{t_np1, time.dt, n, k};
+        SolidStepResult s;
+        {
+          Timer t(solid_time);
+          s = solid_.solve_step(info, force);
+        }
+        if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
+          throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
+        Eigen::VectorXd d_f, v_f;
+        {
+          Timer t(coupler_time);
+          d_f = map_.to_fluid(s.interface_displacement);
+          v_f = map_.to_fluid(s.interface_velocity);
+        }
+        FluidLoads loads;
+        {
+          Timer t(fluid_time);
+          loads = fluid_.solve_step(info, d_f, v_f);
+        }
+        Eigen::VectorXd relaxed;
+        {
+          Timer t(coupler_time);
+          const Eigen::VectorXd f_star = robin_force(map_.to_solid(loads.traction_force),
+                                                     map_.to_solid(loads.velocity_integral), s.interface_velocity,
+                                                     s.interface_displacement);
+          relaxed = -settings_.relaxation * f_star + (1.0 - settings_.relaxation) * force;
+        }
+        if (!all_finite(relaxed))
+          throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
+        const double norm = relaxed.norm();
+        residual = (relaxed - force).norm() / std::max(norm, settings_.residual_floor);
+        iterations.row(std::vector<double>{double(n), t_np1, double(k), residual, norm, double(s.newton_iterations),
+                                           double(loads.nonlinear_iterations)});
+        force = relaxed;
+        ++out.iterations;
+        if (norm > settings_.force_limit)
+          throw Stop{"diverged", fmt::format("interface force norm {:.3e} exceeds force_limit {:.3e} at step {} "
+                                             "iteration {} (loosely coupled instability?)",
+                                             norm, settings_.force_limit, n, k)};
+        if (k == 1) first_residual = residual;
+        if (settings_.tolerance > 0) {
+          if (residual < settings_.tolerance) {
+            converged = true;
+            break;
+          }
+          if (k > 1 && residual > settings_.divergence_factor * std::max(first_residual, settings_.residual_floor))
+            throw Stop{"diverged", fmt::format("coupling residual grew from {:.3e} to {:.3e} at step {} iteration {} "
+                                               "(relaxation {} above the stability limit?)",
+                                               first_residual, residual, n, k, settings_.relaxation)};
+        }
+      }
+      const int used = std::min(k, settings_.max_iterations);
+      if (!converged && settings_.stop_if_not_converged)
+        throw Stop{"diverged", fmt::format("coupling tolerance {:.1e} not reached in {} iterations at step {} "
+                                           "(last residual {:.3e}, first {:.3e})",
+                                           settings_.tolerance, settings_.max_iterations, n, residual, first_residual)};
+      // Accept the step on both sides; record probes.
+      const StepInfo accepted{t_np1, time.dt, n, used};
+      std::map<std::string, double> row;
+      {
+        Timer t(solid_time);
+        for (const auto& [name, v] : solid_.accept_step(accepted)) row["solid." + name] = v;
+      }
+      {
+        Timer t(fluid_time);
+        for (const auto& [name, v] : fluid_.accept_step(accepted)) row["fluid." + name] = v;
+      }
+      row["coupling.iterations"] = used;
+      row["coupling.residual"] = residual;
+      for (const auto& [name, v] : row)
+        if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
+      probes.add(t_np1, row);
+      if (time.output_every > 0 && n % time.output_every == 0) {
+        solid_.write_output(accepted);
+        fluid_.write_output(accepted);
+      }
+      force_nm1 = force_n;
+      force_n = force;
+      out.steps = n;
+      times_.total = now() - start;
+      if (on_step) on_step(out);
+      progress.update(n, t_np1, fmt::format("iterations {} residual {:.2e}", used, residual));
+    }
+    out.status = "completed";
+  } catch (const Stop& stop) {
+    out.status = stop.status;
+    out.reason = stop.reason;
+  } catch (const ConfigError& e) {
+    out.status = "failed";
+    out.reason = std::string("configuration: ") + e.what();
+  } catch (const SolverError& e) {
+    out.status = "diverged";
+    out.reason = fmt::format("solver failed at step {}: {}", out.steps + 1, e.what());
+  } catch (const std::exception& e) {
+    out.status = "failed";
+    out.reason = fmt::format("at step {}: {}", out.steps + 1, e.what());
+  }
+  times_.total = now() - start;
+  return out;
+}
+
+}  // namespace fsi::coupling

@@ -1,0 +1,79 @@
+#include "fsi/coupling/interface_map.hpp"
+
+#include <fmt/format.h>
+
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace fsi::coupling {
+
+InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
+  const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
+  if (ns == 0 && nf == 0) {
+    h_.resize(0, 0);
+    ht_.resize(0, 0);
+    return;
+  }
+  if (ns == 0 || nf == 0)
+    throw std::invalid_argument(fmt::format("interface mismatch: the solid has {} interface nodes, the fluid {}", ns, nf));
+  std::vector<Eigen::Triplet<double>> t;
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    const Eigen::Vector2d p = fluid.coordinates.row(i).transpose();
+    double best = std::numeric_limits<double>::infinity();
+    int a = 0, b = 0;
+    double xi = 0;
+    if (solid.segments.empty()) {
+      for (Eigen::Index j = 0; j < ns; ++j) {
+        const double dist = (solid.coordinates.row(j).transpose() - p).norm();
+        if (dist < best) best = dist, a = b = static_cast<int>(j), xi = 0;
+      }
+    } else {
+      for (const auto& seg : solid.segments) {
+        const Eigen::Vector2d x0 = solid.coordinates.row(seg[0]).transpose();
+        const Eigen::Vector2d x1 = solid.coordinates.row(seg[1]).transpose();
+        const Eigen::Vector2d e = x1 - x0;
+        const double len2 = e.squaredNorm();
+        double s = len2 > 0 ? (p - x0).dot(e) / len2 : 0.0;
+        s = std::clamp(s, 0.0, 1.0);
+        const double dist = (x0 + s * e - p).norm();
+        if (dist < best) best = dist, a = seg[0], b = seg[1], xi = s;
+      }
+    }
+    max_gap_ = std::max(max_gap_, best);
+    for (int c = 0; c < 2; ++c) {
+      t.emplace_back(2 * i + c, 2 * a + c, 1.0 - xi);
+      if (xi > 0) t.emplace_back(2 * i + c, 2 * b + c, xi);
+    }
+  }
+  h_.resize(2 * nf, 2 * ns);
+  h_.setFromTriplets(t.begin(), t.end());
+  ht_ = h_.transpose();
+}
+
+Eigen::SparseMatrix<double> interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement) {
+  const Eigen::Index n = solid.coordinates.rows();
+  Eigen::SparseMatrix<double> m(2 * n, 2 * n);
+  std::vector<Eigen::Triplet<double>> t;
+  if (solid.segments.empty()) {
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (int c = 0; c < 2; ++c) t.emplace_back(2 * i + c, 2 * i + c, solid.lumped_measure[i]);
+  } else {
+    auto x = [&](int i) {
+      Eigen::Vector2d p = solid.coordinates.row(i).transpose();
+      if (displacement.size() == 2 * n) p += displacement.segment<2>(2 * i);
+      return p;
+    };
+    for (const auto& seg : solid.segments) {
+      const double len = (x(seg[1]) - x(seg[0])).norm();
+      const double mij[2][2] = {{len / 3, len / 6}, {len / 6, len / 3}};
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+          for (int c = 0; c < 2; ++c) t.emplace_back(2 * seg[a] + c, 2 * seg[b] + c, mij[a][b]);
+    }
+  }
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
+}
+
+}  // namespace fsi::coupling

@@ -1,0 +1,113 @@
+// coupler: runs a scene's FSI time loop against a solid server and a fluid server.
+//
+// Sample runs (the launcher `fsi run` does all of this for you on loopback):
+//   solid_server --bind 'tcp://127.0.0.1:*' --port-file s.port &
+//   fluid_server --bind 'tcp://127.0.0.1:*' --port-file f.port &
+//   coupler configs/sdof_model.yaml --solid $(cat s.port) --fluid $(cat f.port) --out runs/sdof
+// Exit code: 0 completed, 2 diverged (the run's summary says why), 1 failed.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <csignal>
+
+#include "fsi/common/log.hpp"
+#include "fsi/common/run_report.hpp"
+#include "fsi/coupling/coupler.hpp"
+#include "fsi/protocol/remote.hpp"
+
+namespace {
+extern "C" void on_signal(int) { fsi::coupling::Coupler::interrupt_flag() = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  // 1. Parse options.
+  CLI::App app{"FSI coupler"};
+  std::string scene_path, solid_endpoint, fluid_endpoint, out_dir = "out";
+  std::vector<std::string> overrides;
+  double timeout = 600, connect_timeout = 20;
+  app.add_option("scene", scene_path, "scene file (configs/*.yaml)")->required();
+  app.add_option("--solid", solid_endpoint, "solid server endpoint, e.g. tcp://127.0.0.1:5555")->required();
+  app.add_option("--fluid", fluid_endpoint, "fluid server endpoint, e.g. tcp://127.0.0.1:5556")->required();
+  app.add_option("--out", out_dir, "output folder");
+  app.add_option("--set", overrides, "override a scene key: dotted.key=value");
+  app.add_option("--timeout", timeout, "seconds to wait for any reply (a dead peer is detected at once)");
+  app.add_option("--connect-timeout", connect_timeout, "seconds to wait for the handshake");
+  CLI11_PARSE(app, argc, argv);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  auto log = fsi::logger("coupler");
+
+  // 2. Load the scene; the report exists from here on, whatever happens.
+  std::unique_ptr<fsi::Scene> scene;
+  try {
+    scene = std::make_unique<fsi::Scene>(fsi::Scene::load(scene_path, overrides));
+  } catch (const std::exception& e) {
+    log->error("{}", e.what());
+    return 1;
+  }
+  fsi::RunReport report(out_dir, *scene, "coupler");
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<fsi::protocol::RemoteSolid> solid;
+  std::unique_ptr<fsi::protocol::RemoteFluid> fluid;
+  fsi::coupling::RunOutcome outcome;
+  auto fill_times = [&](const fsi::coupling::Coupler* coupler) {
+    auto& w = report.data()["wall_time"];
+    w["total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (solid) w["solid_compute"] = solid->times().compute, w["solid_messaging"] = solid->times().messaging();
+    if (fluid) w["fluid_compute"] = fluid->times().compute, w["fluid_messaging"] = fluid->times().messaging();
+    if (coupler) w["coupler_mapping_relaxation"] = coupler->times().coupler;
+    report.data()["steps"] = outcome.steps;
+    report.data()["coupling_iterations"] = outcome.iterations;
+  };
+
+  // 3. Connect (handshake), run, stop the servers.
+  try {
+    const auto connect = std::chrono::milliseconds(static_cast<long>(connect_timeout * 1000));
+    const auto wait = std::chrono::milliseconds(static_cast<long>(timeout * 1000));
+    solid = std::make_unique<fsi::protocol::RemoteSolid>(
+        std::make_unique<fsi::protocol::ProtocolClient>(solid_endpoint, "solid server", connect));
+    fluid = std::make_unique<fsi::protocol::RemoteFluid>(
+        std::make_unique<fsi::protocol::ProtocolClient>(fluid_endpoint, "fluid server", connect));
+    solid->client().set_timeout(wait);
+    fluid->client().set_timeout(wait);
+    log->info("connected: solid '{}' at {}, fluid '{}' at {}", solid->name(), solid_endpoint, fluid->name(),
+              fluid_endpoint);
+    report.data()["servers"] = {{"solid", {{"name", solid->name()}, {"endpoint", solid_endpoint}}},
+                                {"fluid", {{"name", fluid->name()}, {"endpoint", fluid_endpoint}}}};
+    fsi::coupling::Coupler coupler(*solid, *fluid, *scene, out_dir);
+    auto last_write = std::chrono::steady_clock::now();
+    coupler.on_step = [&](const fsi::coupling::RunOutcome& o) {
+      outcome.steps = o.steps;
+      outcome.iterations = o.iterations;
+      if (std::chrono::steady_clock::now() - last_write > std::chrono::seconds(2)) {
+        fill_times(&coupler);
+        report.write();
+        last_write = std::chrono::steady_clock::now();
+      }
+    };
+    outcome = coupler.run(report);
+    fill_times(&coupler);
+  } catch (const std::exception& e) {
+    outcome.status = "failed";
+    outcome.reason = e.what();
+    fill_times(nullptr);
+  }
+  report.set_status(outcome.status, outcome.reason);
+  report.write();
+  try {
+    if (solid) solid->stop(outcome.status);
+  } catch (const std::exception& e) {
+    log->warn("could not stop the solid server: {}", e.what());
+  }
+  try {
+    if (fluid) fluid->stop(outcome.status);
+  } catch (const std::exception& e) {
+    log->warn("could not stop the fluid server: {}", e.what());
+  }
+  if (outcome.status == "completed")
+    log->info("completed {} steps, {} coupling iterations; results in {}", outcome.steps, outcome.iterations, out_dir);
+  else
+    log->error("{}: {}", outcome.status, outcome.reason);
+  return outcome.exit_code();
+}

@@ -1,0 +1,38 @@
+#include "fsi/coupling/settings.hpp"
+
+namespace fsi::coupling {
+
+std::string to_string(Algorithm a) {
+  return a == Algorithm::ExplicitSolidVelocity ? "1 (explicit solid velocity)" : "2 (implicit solid velocity, M_fs damping)";
+}
+
+CouplingSettings read_coupling(const ConfigSection& s) {
+  CouplingSettings c;
+  const int algorithm = s.get<int>("algorithm");
+  if (algorithm != 1 && algorithm != 2) s.fail("algorithm", "must be 1 (explicit) or 2 (implicit solid velocity)");
+  c.algorithm = static_cast<Algorithm>(algorithm);
+  c.nitsche_penalty = s.get<double>("gamma_n1");
+  if (c.nitsche_penalty < 0) s.fail("gamma_n1", "must be >= 0");
+  c.nitsche_symmetry = s.get<double>("gamma_n2", -1.0);
+  if (c.nitsche_symmetry != 1.0 && c.nitsche_symmetry != -1.0) s.fail("gamma_n2", "must be +1 or -1");
+  c.relaxation = s.get<double>("relaxation");
+  if (!(c.relaxation > 0) || c.relaxation > 1.0 + 1e-12)
+    s.fail("relaxation", "(beta) must be in (0, 1]");
+  const auto predictor = s.get<std::string>("predictor", "previous");
+  if (predictor == "previous") c.predictor = Predictor::Previous;
+  else if (predictor == "linear") c.predictor = Predictor::Linear;
+  else s.fail("predictor", "must be 'previous' (the paper: F_n) or 'linear' (2 F_n - F_{n-1})");
+  const auto it = s.child("iterations");
+  c.max_iterations = it.get<int>("max");
+  if (c.max_iterations < 1) it.fail("max", "must be >= 1");
+  c.tolerance = it.get<double>("tolerance", 0.0);
+  if (c.tolerance < 0) it.fail("tolerance", "must be >= 0 (0 = fixed number of iterations)");
+  c.stop_if_not_converged = it.get<bool>("stop_if_not_converged", true);
+  c.divergence_factor = it.get<double>("divergence_factor", 1e4);
+  if (!(c.divergence_factor > 1)) it.fail("divergence_factor", "must be > 1");
+  c.force_limit = s.get<double>("force_limit", 1e12);
+  if (!(c.force_limit > 0)) s.fail("force_limit", "must be positive");
+  return c;
+}
+
+}  // namespace fsi::coupling

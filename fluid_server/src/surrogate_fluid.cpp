@@ -1,0 +1,60 @@
+#include "fsi/models/surrogate_fluid.hpp"
+
+namespace fsi::models {
+namespace {
+Eigen::Vector2d read_vector2(const ConfigSection& section, const std::string& key) {
+  if (!section.has(key)) {
+    section.get<double>(key, 0.0);
+    return Eigen::Vector2d::Zero();
+  }
+  try {
+    return Eigen::Vector2d(section.get<double>(key), 0.0);
+  } catch (const ConfigError&) {
+    const auto v = section.get<std::vector<double>>(key);
+    if (v.size() != 2) section.fail(key, "must be a number or a list [x, y]");
+    return Eigen::Vector2d(v[0], v[1]);
+  }
+}
+}  // namespace
+
+void SurrogateFluid::configure(const ConfigSection& s, const FluidSetup&) {
+  force_ = read_vector2(s, "force");
+  added_mass_ = s.get<double>("added_mass", 0.0);
+  measure_ = s.get<double>("interface_measure", 1.0);
+  if (added_mass_ < 0) s.fail("added_mass", "must be >= 0");
+  if (!(measure_ > 0)) s.fail("interface_measure", "must be positive");
+}
+
+InterfaceMeshData SurrogateFluid::interface() const {
+  InterfaceMeshData data;
+  data.node_ids = {0};
+  data.coordinates = Eigen::MatrixX2d::Zero(1, 2);
+  data.lumped_measure = Eigen::VectorXd::Constant(1, measure_);
+  return data;
+}
+
+FluidLoads SurrogateFluid::loads(const Eigen::Vector2d& v, const Eigen::Vector2d& acceleration) {
+  last_force_on_solid_ = force_ - added_mass_ * acceleration;
+  FluidLoads out;
+  out.traction_force = -last_force_on_solid_;
+  out.velocity_integral = measure_ * v;
+  out.nonlinear_iterations = 1;
+  return out;
+}
+
+FluidLoads SurrogateFluid::initial_loads(const Eigen::VectorXd&, const Eigen::VectorXd& v) {
+  v_n_ = v_ = v.head<2>();
+  return loads(v_, Eigen::Vector2d::Zero());
+}
+
+FluidLoads SurrogateFluid::solve_step(const StepInfo& info, const Eigen::VectorXd&, const Eigen::VectorXd& v) {
+  v_ = v.head<2>();
+  return loads(v_, (v_ - v_n_) / info.dt);
+}
+
+std::map<std::string, double> SurrogateFluid::accept_step(const StepInfo&) {
+  v_n_ = v_;
+  return {{"force_x", last_force_on_solid_[0]}, {"force_y", last_force_on_solid_[1]}};
+}
+
+}  // namespace fsi::models

@@ -1,0 +1,64 @@
+#pragma once
+// Client side: a SolidModel / FluidModel whose work is done by a server process. The
+// coupler drives these exactly like in-process models.
+#include <memory>
+
+#include "fsi/common/solver_model.hpp"
+#include "fsi/protocol/client.hpp"
+
+namespace fsi::protocol {
+
+struct RemoteTimes {
+  double wall = 0;       // seconds inside calls
+  double compute = 0;    // seconds the server reported computing
+  double messaging() const { return wall > compute ? wall - compute : 0.0; }
+};
+
+class RemoteSolid : public SolidModel {
+ public:
+  explicit RemoteSolid(std::unique_ptr<ProtocolClient> client);
+  std::string name() const override { return server_name_; }
+  bool supports_interface_damping() const override { return supports_damping_; }
+  void configure(const ConfigSection& section, const SolidSetup& setup) override;
+  InterfaceMeshData interface() const override { return interface_; }
+  SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
+  std::map<std::string, double> accept_step(const StepInfo& info) override;
+  std::vector<std::string> write_output(const StepInfo& info) override;
+  void stop(const std::string& reason);
+  RemoteTimes times() const { return {client_->wall_seconds(), client_->server_compute_seconds()}; }
+  ProtocolClient& client() { return *client_; }
+
+ private:
+  std::unique_ptr<ProtocolClient> client_;
+  std::string server_name_ = "solid server";
+  bool supports_damping_ = false;
+  InterfaceMeshData interface_;
+};
+
+class RemoteFluid : public FluidModel {
+ public:
+  explicit RemoteFluid(std::unique_ptr<ProtocolClient> client);
+  std::string name() const override { return server_name_; }
+  void configure(const ConfigSection& section, const FluidSetup& setup) override;
+  InterfaceMeshData interface() const override { return interface_; }
+  FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
+  FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
+  std::map<std::string, double> accept_step(const StepInfo& info) override;
+  std::vector<std::string> write_output(const StepInfo& info) override;
+  void stop(const std::string& reason);
+  RemoteTimes times() const { return {client_->wall_seconds(), client_->server_compute_seconds()}; }
+  ProtocolClient& client() { return *client_; }
+
+ private:
+  std::unique_ptr<ProtocolClient> client_;
+  std::string server_name_ = "fluid server";
+  InterfaceMeshData interface_;
+};
+
+// Conversions between Eigen vectors and repeated double fields.
+Eigen::VectorXd to_eigen(const google::protobuf::RepeatedField<double>& field);
+void from_eigen(const Eigen::VectorXd& v, google::protobuf::RepeatedField<double>* field);
+InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh);
+void interface_to_proto(const InterfaceMeshData& data, fsi::v1::InterfaceMesh* mesh);
+
+}  // namespace fsi::protocol

@@ -1,0 +1,63 @@
+#pragma once
+// Server side: turns wire requests into calls on a SolidModel / FluidModel, and every
+// outcome (including exceptions) into exactly one Reply. A request that does not parse,
+// has the wrong version or arrives out of order gets an Error reply; the server stays up.
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "fsi/common/solver_model.hpp"
+#include "fsi/common/standalone.hpp"
+#include "fsi/v1/coupling.pb.h"
+
+namespace fsi::protocol {
+
+// Handles raw request bytes -> raw reply bytes; sets `stop` after a Stop request.
+class Service {
+ public:
+  virtual ~Service() = default;
+  std::string handle_bytes(const std::string& request_bytes, bool& stop);
+  fsi::v1::Reply handle(const fsi::v1::Request& request, bool& stop);
+
+ protected:
+  virtual void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) = 0;
+};
+
+using fsi::SolidFactory;
+using fsi::FluidFactory;
+
+class SolidService : public Service {
+ public:
+  SolidService(SolidFactory factory, std::string server_name);
+
+ protected:
+  void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) override;
+
+ private:
+  SolidFactory factory_;
+  std::string server_name_;
+  std::unique_ptr<SolidModel> model_;
+  std::size_t interface_nodes_ = 0;
+  double dt_ = 0;
+};
+
+class FluidService : public Service {
+ public:
+  FluidService(FluidFactory factory, std::string server_name);
+
+ protected:
+  void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) override;
+
+ private:
+  FluidFactory factory_;
+  std::string server_name_;
+  std::unique_ptr<FluidModel> model_;
+  std::size_t interface_nodes_ = 0;
+};
+
+// Binds `endpoint`, writes the bound endpoint to `port_file` (if non-empty, atomically),
+// and serves until Stop, idle timeout, or SIGINT/SIGTERM. Returns the process exit code.
+int run_server(Service& service, const std::string& endpoint, const std::string& port_file,
+               double idle_timeout_seconds, const std::string& log_name);
+
+}  // namespace fsi::protocol

@@ -1,0 +1,255 @@
+#include "fsi/protocol/remote.hpp"
+
+#include <fmt/format.h>
+
+namespace fsi::protocol {
+
+Eigen::VectorXd to_eigen(const google::protobuf::RepeatedField<double>& field) {
+  Eigen::VectorXd v(field.size());
+  for (int i = 0; i < field.size(); ++i) v[i] = field.Get(i);
+  return v;
+}
+
+void from_eigen(const Eigen::VectorXd& v, google::protobuf::RepeatedField<double>* field) {
+  field->Resize(static_cast<int>(v.size()), 0.0);
+  for (Eigen::Index i = 0; i < v.size(); ++i) field->Set(static_cast<int>(i), v[i]);
+}
+
+InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
+  InterfaceMeshData data;
+  const int n = mesh.coordinates_size() / 2;
+  if (mesh.coordinates_size() % 2 != 0)
+    throw std::invalid_argument("interface mesh: odd number of coordinates");
+  data.coordinates.resize(n, 2);
+  for (int i = 0; i < n; ++i) {
+    data.coordinates(i, 0) = mesh.coordinates(2 * i);
+    data.coordinates(i, 1) = mesh.coordinates(2 * i + 1);
+  }
+  data.node_ids.assign(mesh.node_ids().begin(), mesh.node_ids().end());
+  if (data.node_ids.empty())
+    for (int i = 0; i < n; ++i) data.node_ids.push_back(i);
+  if (static_cast<int>(data.node_ids.size()) != n)
+    throw std::invalid_argument(fmt::format("interface mesh: {} node ids for {} nodes", data.node_ids.size(), n));
+  if (mesh.segments_size() % 2 != 0) throw std::invalid_argument("interface mesh: odd number of segment indices");
+  for (int s = 0; s < mesh.segments_size() / 2; ++s) {
+    const int a = static_cast<int>(mesh.segments(2 * s)), b = static_cast<int>(mesh.segments(2 * s + 1));
+    if (a >= n || b >= n)
+      throw std::invalid_argument(fmt::format("interface mesh: segment {} refers to node {} of {}", s, std::max(a, b), n));
+    data.segments.push_back({a, b});
+  }
+  data.lumped_measure = to_eigen(mesh.lumped_measure());
+  if (data.segments.empty() && data.lumped_measure.size() != n && n > 0)
+    throw std::invalid_argument("interface mesh: a point interface needs one lumped_measure per node");
+  data.initial_displacement = to_eigen(mesh.initial_displacement());
+  data.initial_velocity = to_eigen(mesh.initial_velocity());
+  return data;
+}
+
+void interface_to_proto(const InterfaceMeshData& data, fsi::v1::InterfaceMesh* mesh) {
+  for (auto id : data.node_ids) mesh->add_node_ids(id);
+  for (Eigen::Index i = 0; i < data.coordinates.rows(); ++i) {
+    mesh->add_coordinates(data.coordinates(i, 0));
+    mesh->add_coordinates(data.coordinates(i, 1));
+  }
+  for (const auto& s : data.segments) {
+    mesh->add_segments(static_cast<unsigned>(s[0]));
+    mesh->add_segments(static_cast<unsigned>(s[1]));
+  }
+  from_eigen(data.lumped_measure, mesh->mutable_lumped_measure());
+  from_eigen(data.initial_displacement, mesh->mutable_initial_displacement());
+  from_eigen(data.initial_velocity, mesh->mutable_initial_velocity());
+}
+
+namespace {
+
+fsi::v1::Request configure_request(const ConfigSection& section, double dt, double end_time,
+                                   const std::string& output_dir) {
+  fsi::v1::Request r;
+  auto* c = r.mutable_configure();
+  c->set_dt(dt);
+  c->set_end_time(end_time);
+  c->set_scene_text(section.scene_text());
+  c->set_scene_path(section.scene_origin());
+  for (const auto& o : section.scene_overrides()) c->add_overrides(o);
+  c->set_section(section.path());
+  c->set_output_dir(output_dir);
+  return r;
+}
+
+std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* supports_damping) {
+  fsi::v1::Request r;
+  r.mutable_hello()->set_client_name("fsi coupler");
+  const auto reply = client.call(r);
+  if (!reply.has_hello())
+    throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " did not answer the handshake with hello");
+  if (reply.hello().kind() != expected)
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} at {} is a {} server, expected a {} server", client.peer_name(),
+                                  client.endpoint(), fsi::v1::ServerKind_Name(reply.hello().kind()),
+                                  fsi::v1::ServerKind_Name(expected)));
+  if (supports_damping) *supports_damping = reply.hello().supports_interface_damping();
+  return reply.hello().server_name();
+}
+
+// A solver failure on the server side is a SolverError on this side (the run diverged),
+// any other error reply stays a RemoteError (the run failed).
+fsi::v1::Reply step_call(ProtocolClient& client, const fsi::v1::Request& r) {
+  try {
+    return client.call(r);
+  } catch (const RemoteError& e) {
+    if (e.code() == fsi::v1::Error::SOLVER_FAILED) throw SolverError(e.what());
+    throw;
+  }
+}
+
+void expect(bool ok, const ProtocolClient& client, const char* what) {
+  if (!ok) throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " answered with the wrong reply to " + what);
+}
+
+Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, std::size_t n, const ProtocolClient& client,
+                        const char* what) {
+  if (static_cast<std::size_t>(f.size()) != 2 * n)
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} sent {} values for '{}', expected {}", client.peer_name(), f.size(), what, 2 * n));
+  Eigen::VectorXd v = to_eigen(f);
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw SolverError(fmt::format("{} sent a non-finite '{}' at node {}", client.peer_name(), what, i / 2));
+  return v;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------- solid
+RemoteSolid::RemoteSolid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_);
+}
+
+void RemoteSolid::configure(const ConfigSection& section, const SolidSetup& setup) {
+  auto r = configure_request(section, setup.dt, setup.end_time, setup.output_dir.string());
+  r.mutable_configure()->set_interface_damping(setup.interface_damping);
+  expect(client_->call(r).has_configure(), *client_, "configure");
+  fsi::v1::Request g;
+  g.mutable_get_interface();
+  const auto reply = client_->call(g);
+  expect(reply.has_interface(), *client_, "get_interface");
+  interface_ = interface_from_proto(reply.interface());
+}
+
+SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& force) {
+  fsi::v1::Request r;
+  auto* s = r.mutable_solve_step();
+  s->set_time(info.time);
+  s->set_dt(info.dt);
+  s->set_step(static_cast<unsigned>(info.step));
+  s->set_iteration(static_cast<unsigned>(info.iteration));
+  from_eigen(force, s->mutable_interface_force());
+  const auto reply = step_call(*client_, r);
+  expect(reply.has_solid_step(), *client_, "solve_step");
+  SolidStepResult out;
+  out.interface_displacement = checked(reply.solid_step().interface_displacement(), interface_.nodes(), *client_,
+                                       "interface_displacement");
+  out.interface_velocity = checked(reply.solid_step().interface_velocity(), interface_.nodes(), *client_,
+                                   "interface_velocity");
+  out.newton_iterations = static_cast<int>(reply.solid_step().newton_iterations());
+  return out;
+}
+
+std::map<std::string, double> RemoteSolid::accept_step(const StepInfo& info) {
+  fsi::v1::Request r;
+  r.mutable_accept_step()->set_time(info.time);
+  r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
+  const auto reply = client_->call(r);
+  expect(reply.has_accept(), *client_, "accept_step");
+  return {reply.accept().probes().begin(), reply.accept().probes().end()};
+}
+
+std::vector<std::string> RemoteSolid::write_output(const StepInfo& info) {
+  fsi::v1::Request r;
+  r.mutable_write_output()->set_time(info.time);
+  r.mutable_write_output()->set_step(static_cast<unsigned>(info.step));
+  const auto reply = client_->call(r);
+  expect(reply.has_output(), *client_, "write_output");
+  return {reply.output().files().begin(), reply.output().files().end()};
+}
+
+void RemoteSolid::stop(const std::string& reason) {
+  fsi::v1::Request r;
+  r.mutable_stop()->set_reason(reason);
+  client_->set_timeout(std::chrono::seconds(5));
+  client_->call(r);
+}
+
+// ---------------------------------------------------------------------------- fluid
+RemoteFluid::RemoteFluid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_FLUID, nullptr);
+}
+
+void RemoteFluid::configure(const ConfigSection& section, const FluidSetup& setup) {
+  auto r = configure_request(section, setup.dt, setup.end_time, setup.output_dir.string());
+  r.mutable_configure()->set_nitsche_penalty(setup.nitsche_penalty);
+  r.mutable_configure()->set_nitsche_symmetry(setup.nitsche_symmetry);
+  expect(client_->call(r).has_configure(), *client_, "configure");
+  fsi::v1::Request g;
+  g.mutable_get_interface();
+  const auto reply = client_->call(g);
+  expect(reply.has_interface(), *client_, "get_interface");
+  interface_ = interface_from_proto(reply.interface());
+}
+
+namespace {
+FluidLoads loads_from(const fsi::v1::Reply& reply, std::size_t n, const ProtocolClient& client) {
+  expect(reply.has_fluid_loads(), client, "a fluid solve");
+  FluidLoads out;
+  out.traction_force = checked(reply.fluid_loads().traction_force(), n, client, "traction_force");
+  out.velocity_integral = checked(reply.fluid_loads().velocity_integral(), n, client, "velocity_integral");
+  out.nonlinear_iterations = static_cast<int>(reply.fluid_loads().nonlinear_iterations());
+  return out;
+}
+}  // namespace
+
+FluidLoads RemoteFluid::initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) {
+  fsi::v1::Request r;
+  from_eigen(d, r.mutable_initial_loads()->mutable_interface_displacement());
+  from_eigen(v, r.mutable_initial_loads()->mutable_interface_velocity());
+  return loads_from(client_->call(r), interface_.nodes(), *client_);
+}
+
+FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) {
+  fsi::v1::Request r;
+  auto* s = r.mutable_solve_step();
+  s->set_time(info.time);
+  s->set_dt(info.dt);
+  s->set_step(static_cast<unsigned>(info.step));
+  s->set_iteration(static_cast<unsigned>(info.iteration));
+  from_eigen(d, s->mutable_interface_displacement());
+  from_eigen(v, s->mutable_interface_velocity());
+  return loads_from(step_call(*client_, r), interface_.nodes(), *client_);
+}
+
+std::map<std::string, double> RemoteFluid::accept_step(const StepInfo& info) {
+  fsi::v1::Request r;
+  r.mutable_accept_step()->set_time(info.time);
+  r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
+  const auto reply = client_->call(r);
+  expect(reply.has_accept(), *client_, "accept_step");
+  return {reply.accept().probes().begin(), reply.accept().probes().end()};
+}
+
+std::vector<std::string> RemoteFluid::write_output(const StepInfo& info) {
+  fsi::v1::Request r;
+  r.mutable_write_output()->set_time(info.time);
+  r.mutable_write_output()->set_step(static_cast<unsigned>(info.step));
+  const auto reply = client_->call(r);
+  expect(reply.has_output(), *client_, "write_output");
+  return {reply.output().files().begin(), reply.output().files().end()};
+}
+
+void RemoteFluid::stop(const std::string& reason) {
+  fsi::v1::Request r;
+  r.mutable_stop()->set_reason(reason);
+  client_->set_timeout(std::chrono::seconds(5));
+  client_->call(r);
+}
+
+}  // namespace fsi::protocol

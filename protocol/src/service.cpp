@@ -1,0 +1,304 @@
+#include "fsi/protocol/service.hpp"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include "fsi/common/log.hpp"
+#include "fsi/protocol/client.hpp"
+#include "fsi/protocol/remote.hpp"
+#include "fsi/transport/transport.hpp"
+
+namespace fsi::protocol {
+namespace {
+
+void set_error(fsi::v1::Reply& reply, fsi::v1::Error::Code code, const std::string& message) {
+  reply.clear_body();
+  reply.mutable_error()->set_code(code);
+  reply.mutable_error()->set_message(message);
+}
+
+// Checks a received vector: expected size and every entry finite.
+Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& field,
+                               std::size_t expected, const char* name) {
+  if (static_cast<std::size_t>(field.size()) != expected)
+    throw std::invalid_argument(
+        fmt::format("'{}' has {} values, expected {} (2 per interface node)", name, field.size(), expected));
+  for (int i = 0; i < field.size(); ++i)
+    if (!std::isfinite(field.Get(i)))
+      throw std::invalid_argument(fmt::format("'{}' value {} (node {}, component {}) is not finite: {}",
+                                              name, i, i / 2, i % 2 ? "y" : "x", field.Get(i)));
+  return to_eigen(field);
+}
+
+void require_finite(const Eigen::VectorXd& v, const std::string& what) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw SolverError(fmt::format("{} produced a non-finite value at node {} ({}): {}", what, i / 2,
+                                    i % 2 ? "y" : "x", v[i]));
+}
+
+Scene scene_from(const fsi::v1::Configure& c) {
+  std::vector<std::string> overrides(c.overrides().begin(), c.overrides().end());
+  return Scene::parse(c.scene_text(), c.scene_path().empty() ? "<scene>" : c.scene_path(), overrides);
+}
+
+std::atomic<bool> g_signalled{false};
+extern "C" void on_signal(int) { g_signalled = true; }
+
+}  // namespace
+
+fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop) {
+  fsi::v1::Reply reply;
+  reply.set_protocol_version(kProtocolVersion);
+  reply.set_sequence(request.sequence());
+  const auto start = std::chrono::steady_clock::now();
+  if (request.protocol_version() != kProtocolVersion) {
+    set_error(reply, fsi::v1::Error::VERSION_MISMATCH,
+              fmt::format("protocol version mismatch: request has {}, this server speaks {}",
+                          request.protocol_version(), kProtocolVersion));
+    return reply;
+  }
+  if (request.body_case() == fsi::v1::Request::BODY_NOT_SET) {
+    set_error(reply, fsi::v1::Error::MALFORMED, "request has no body");
+    return reply;
+  }
+  try {
+    dispatch(request, reply, stop);
+  } catch (const ConfigError& e) {
+    set_error(reply, fsi::v1::Error::INVALID_ARGUMENT, e.what());
+  } catch (const std::invalid_argument& e) {
+    set_error(reply, fsi::v1::Error::INVALID_ARGUMENT, e.what());
+  } catch (const SolverError& e) {
+    set_error(reply, fsi::v1::Error::SOLVER_FAILED, e.what());
+  } catch (const RemoteError& e) {
+    set_error(reply, e.code(), e.what());
+  } catch (const std::exception& e) {
+    set_error(reply, fsi::v1::Error::INTERNAL, e.what());
+  }
+  reply.set_compute_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return reply;
+}
+
+std::string Service::handle_bytes(const std::string& bytes, bool& stop) {
+  fsi::v1::Request request;
+  if (!request.ParseFromString(bytes)) {
+    fsi::v1::Reply reply;
+    reply.set_protocol_version(kProtocolVersion);
+    set_error(reply, fsi::v1::Error::MALFORMED,
+              fmt::format("message of {} bytes is not a fsi.v1.Request", bytes.size()));
+    return reply.SerializeAsString();
+  }
+  return handle(request, stop).SerializeAsString();
+}
+
+// ---------------------------------------------------------------------------- solid
+SolidService::SolidService(SolidFactory factory, std::string server_name)
+    : factory_(std::move(factory)), server_name_(std::move(server_name)) {}
+
+void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
+  using R = fsi::v1::Request;
+  auto need_model = [&](const char* what) {
+    if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE,
+                                   fmt::format("'{}' before 'configure'", what));
+  };
+  switch (request.body_case()) {
+    case R::kHello: {
+      auto* h = reply.mutable_hello();
+      h->set_kind(fsi::v1::SERVER_KIND_SOLID);
+      h->set_server_name(server_name_);
+      h->set_protocol_version(kProtocolVersion);
+      h->set_supports_interface_damping(true);
+      h->set_supports_output(true);
+      break;
+    }
+    case R::kConfigure: {
+      const auto& c = request.configure();
+      if (!(c.dt() > 0) || !std::isfinite(c.dt()))
+        throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
+      const Scene scene = scene_from(c);
+      const auto section = scene.section(c.section().empty() ? "solid" : c.section());
+      const auto kind = section.get<std::string>("model");
+      auto model = factory_(kind);
+      if (!model) section.fail("model", "names no solid model this server knows ('" + kind + "')");
+      if (c.interface_damping() > 0 && !model->supports_interface_damping())
+        throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                          fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)", kind));
+      SolidSetup setup{c.dt(), c.end_time(), c.interface_damping(), c.output_dir()};
+      model->configure(section, setup);
+      scene.check_all_used(section.path());
+      model_ = std::move(model);
+      interface_nodes_ = model_->interface().nodes();
+      dt_ = c.dt();
+      reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
+      break;
+    }
+    case R::kGetInterface:
+      need_model("get_interface");
+      interface_to_proto(model_->interface(), reply.mutable_interface());
+      break;
+    case R::kSolveStep: {
+      need_model("solve_step");
+      const auto& s = request.solve_step();
+      const Eigen::VectorXd force = checked_vector(s.interface_force(), 2 * interface_nodes_, "interface_force");
+      StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
+      const SolidStepResult result = model_->solve_step(info, force);
+      require_finite(result.interface_displacement, "solid step (displacement)");
+      require_finite(result.interface_velocity, "solid step (velocity)");
+      auto* out = reply.mutable_solid_step();
+      from_eigen(result.interface_displacement, out->mutable_interface_displacement());
+      from_eigen(result.interface_velocity, out->mutable_interface_velocity());
+      out->set_newton_iterations(result.newton_iterations);
+      break;
+    }
+    case R::kAcceptStep: {
+      need_model("accept_step");
+      StepInfo info{request.accept_step().time(), dt_, static_cast<int>(request.accept_step().step()), 0};
+      for (const auto& [k, v] : model_->accept_step(info)) (*reply.mutable_accept()->mutable_probes())[k] = v;
+      reply.mutable_accept();
+      break;
+    }
+    case R::kWriteOutput: {
+      need_model("write_output");
+      StepInfo info{request.write_output().time(), dt_, static_cast<int>(request.write_output().step()), 0};
+      auto* out = reply.mutable_output();
+      for (const auto& f : model_->write_output(info)) out->add_files(f);
+      break;
+    }
+    case R::kStop:
+      reply.mutable_stop();
+      stop = true;
+      break;
+    default:
+      throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                        fmt::format("a solid server does not handle '{}'", body_name(request)));
+  }
+}
+
+// ---------------------------------------------------------------------------- fluid
+FluidService::FluidService(FluidFactory factory, std::string server_name)
+    : factory_(std::move(factory)), server_name_(std::move(server_name)) {}
+
+void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
+  using R = fsi::v1::Request;
+  auto need_model = [&](const char* what) {
+    if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE,
+                                   fmt::format("'{}' before 'configure'", what));
+  };
+  auto loads_reply = [&](const FluidLoads& loads) {
+    require_finite(loads.traction_force, "fluid step (traction force)");
+    require_finite(loads.velocity_integral, "fluid step (velocity integral)");
+    auto* out = reply.mutable_fluid_loads();
+    from_eigen(loads.traction_force, out->mutable_traction_force());
+    from_eigen(loads.velocity_integral, out->mutable_velocity_integral());
+    out->set_nonlinear_iterations(loads.nonlinear_iterations);
+  };
+  switch (request.body_case()) {
+    case R::kHello: {
+      auto* h = reply.mutable_hello();
+      h->set_kind(fsi::v1::SERVER_KIND_FLUID);
+      h->set_server_name(server_name_);
+      h->set_protocol_version(kProtocolVersion);
+      h->set_supports_output(true);
+      break;
+    }
+    case R::kConfigure: {
+      const auto& c = request.configure();
+      if (!(c.dt() > 0) || !std::isfinite(c.dt()))
+        throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
+      const Scene scene = scene_from(c);
+      const auto section = scene.section(c.section().empty() ? "fluid" : c.section());
+      const auto kind = section.get<std::string>("model");
+      auto model = factory_(kind);
+      if (!model) section.fail("model", "names no fluid model this server knows ('" + kind + "')");
+      FluidSetup setup{c.dt(), c.end_time(), c.nitsche_penalty(), c.nitsche_symmetry(), c.output_dir()};
+      model->configure(section, setup);
+      scene.check_all_used(section.path());
+      model_ = std::move(model);
+      interface_nodes_ = model_->interface().nodes();
+      reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
+      break;
+    }
+    case R::kGetInterface:
+      need_model("get_interface");
+      interface_to_proto(model_->interface(), reply.mutable_interface());
+      break;
+    case R::kInitialLoads: {
+      need_model("initial_loads");
+      const auto& s = request.initial_loads();
+      loads_reply(model_->initial_loads(
+          checked_vector(s.interface_displacement(), 2 * interface_nodes_, "interface_displacement"),
+          checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
+      break;
+    }
+    case R::kSolveStep: {
+      need_model("solve_step");
+      const auto& s = request.solve_step();
+      StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
+      loads_reply(model_->solve_step(
+          info, checked_vector(s.interface_displacement(), 2 * interface_nodes_, "interface_displacement"),
+          checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
+      break;
+    }
+    case R::kAcceptStep: {
+      need_model("accept_step");
+      StepInfo info{request.accept_step().time(), 0, static_cast<int>(request.accept_step().step()), 0};
+      reply.mutable_accept();
+      for (const auto& [k, v] : model_->accept_step(info)) (*reply.mutable_accept()->mutable_probes())[k] = v;
+      break;
+    }
+    case R::kWriteOutput: {
+      need_model("write_output");
+      StepInfo info{request.write_output().time(), 0, static_cast<int>(request.write_output().step()), 0};
+      auto* out = reply.mutable_output();
+      for (const auto& f : model_->write_output(info)) out->add_files(f);
+      break;
+    }
+    case R::kStop:
+      reply.mutable_stop();
+      stop = true;
+      break;
+    default:
+      throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                        fmt::format("a fluid server does not handle '{}'", body_name(request)));
+  }
+}
+
+// ---------------------------------------------------------------------------- server loop
+int run_server(Service& service, const std::string& endpoint, const std::string& port_file,
+               double idle_timeout_seconds, const std::string& log_name) {
+  auto log = logger(log_name);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  transport::Server server(endpoint);
+  const std::string bound = server.endpoint();
+  if (!port_file.empty()) {
+    const std::string tmp = port_file + ".tmp";
+    { std::ofstream(tmp) << bound << '\n'; }
+    std::filesystem::rename(tmp, port_file);
+  }
+  log->info("listening on {}", bound);
+  const auto idle = std::chrono::milliseconds(static_cast<long>(idle_timeout_seconds * 1000));
+  const bool clean = server.serve(
+      [&](const std::string& bytes, bool& stop) {
+        std::string reply = service.handle_bytes(bytes, stop);
+        return reply;
+      },
+      idle, [] { return g_signalled.load(); });
+  if (g_signalled) {
+    log->warn("interrupted by a signal, exiting");
+    return 130;
+  }
+  if (!clean) {
+    log->error("no request for {} s, exiting", idle_timeout_seconds);
+    return 3;
+  }
+  log->info("stopped by the coupler");
+  return 0;
+}
+
+}  // namespace fsi::protocol

@@ -1,0 +1,35 @@
+#pragma once
+// Single-degree-of-freedom solid of the seed paper's appendix, as a point interface:
+//   m a + (c + gamma_N1 * measure) v + k d = F_interface + F_external,
+// BDF1 (v_{n+1} = (d_{n+1}-d_n)/dt, a_{n+1} = (v_{n+1}-v_n)/dt), both components
+// independent (an isotropic 2D point mass; the paper's problem is the x component).
+//
+// Scene keys (section `solid`, model: sdof):
+//   mass, damping (0), stiffness (0), force (0; number = x, or [fx, fy]),
+//   interface_measure (1: M_G = measure * I), initial_displacement, initial_velocity
+#include <Eigen/Core>
+
+#include "fsi/common/solver_model.hpp"
+
+namespace fsi::models {
+
+class SdofSolid : public SolidModel {
+ public:
+  std::string name() const override { return "sdof"; }
+  void configure(const ConfigSection& section, const SolidSetup& setup) override;
+  InterfaceMeshData interface() const override;
+  SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
+  std::map<std::string, double> accept_step(const StepInfo& info) override;
+
+ private:
+  double mass_ = 1, damping_ = 0, stiffness_ = 0, measure_ = 1, interface_damping_ = 0;
+  Eigen::Vector2d force_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d d_n_ = Eigen::Vector2d::Zero(), v_n_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d d_ = Eigen::Vector2d::Zero(), v_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d d0_ = Eigen::Vector2d::Zero(), v0_ = Eigen::Vector2d::Zero();
+};
+
+// Reads a number (x component) or a [x, y] list.
+Eigen::Vector2d read_vector2(const ConfigSection& section, const std::string& key);
+
+}  // namespace fsi::models

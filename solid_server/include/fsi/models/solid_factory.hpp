@@ -1,0 +1,13 @@
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fsi/common/solver_model.hpp"
+
+namespace fsi::models {
+// The solid models this server hosts, by the scene's `solid.model` ("sdof", "fem").
+// Returns nullptr for an unknown name.
+std::unique_ptr<SolidModel> make_solid_model(const std::string& name);
+std::vector<std::string> solid_model_names();
+}  // namespace fsi::models

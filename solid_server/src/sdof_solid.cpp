@@ -1,0 +1,65 @@
+#include "fsi/models/sdof_solid.hpp"
+
+namespace fsi::models {
+
+Eigen::Vector2d read_vector2(const ConfigSection& section, const std::string& key) {
+  if (!section.has(key)) {
+    section.get<double>(key, 0.0);  // marks the key as read
+    return Eigen::Vector2d::Zero();
+  }
+  try {
+    return Eigen::Vector2d(section.get<double>(key), 0.0);
+  } catch (const ConfigError&) {
+    const auto v = section.get<std::vector<double>>(key);
+    if (v.size() != 2) section.fail(key, "must be a number or a list [x, y]");
+    for (double x : v)
+      if (!std::isfinite(x)) section.fail(key, "must be finite");
+    return Eigen::Vector2d(v[0], v[1]);
+  }
+}
+
+void SdofSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
+  mass_ = s.get<double>("mass");
+  damping_ = s.get<double>("damping", 0.0);
+  stiffness_ = s.get<double>("stiffness", 0.0);
+  measure_ = s.get<double>("interface_measure", 1.0);
+  force_ = read_vector2(s, "force");
+  d0_ = read_vector2(s, "initial_displacement");
+  v0_ = read_vector2(s, "initial_velocity");
+  if (!(mass_ > 0)) s.fail("mass", "must be positive");
+  if (damping_ < 0) s.fail("damping", "must be >= 0");
+  if (stiffness_ < 0) s.fail("stiffness", "must be >= 0");
+  if (!(measure_ > 0)) s.fail("interface_measure", "must be positive");
+  interface_damping_ = setup.interface_damping * measure_;  // M_fs = gamma_N1 * M_G
+  d_n_ = d_ = d0_;
+  v_n_ = v_ = v0_;
+}
+
+InterfaceMeshData SdofSolid::interface() const {
+  InterfaceMeshData data;
+  data.node_ids = {0};
+  data.coordinates = Eigen::MatrixX2d::Zero(1, 2);
+  data.lumped_measure = Eigen::VectorXd::Constant(1, measure_);
+  data.initial_displacement = d0_;
+  data.initial_velocity = v0_;
+  return data;
+}
+
+SolidStepResult SdofSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) {
+  const double dt = info.dt;
+  const double c = damping_ + interface_damping_;
+  // m (d - d_n - dt v_n)/dt^2 + c (d - d_n)/dt + k d = F
+  const double lhs = mass_ / (dt * dt) + c / dt + stiffness_;
+  const Eigen::Vector2d rhs = interface_force.head<2>() + force_ + mass_ * (d_n_ / (dt * dt) + v_n_ / dt) + c * d_n_ / dt;
+  d_ = rhs / lhs;
+  v_ = (d_ - d_n_) / dt;
+  return {d_, v_, 1};
+}
+
+std::map<std::string, double> SdofSolid::accept_step(const StepInfo&) {
+  d_n_ = d_;
+  v_n_ = v_;
+  return {{"d_x", d_[0]}, {"d_y", d_[1]}, {"v_x", v_[0]}, {"v_y", v_[1]}};
+}
+
+}  // namespace fsi::models

@@ -1,0 +1,79 @@
+#pragma once
+// The only code in the project that includes ZeroMQ. Raw bytes in, raw bytes out; the
+// typed layer (protocol/) sits on top.
+//
+// Server: binds one ROUTER socket; each request is [identity, "", payload] so plain REQ
+//   and REP peers (e.g. a Python solid using zmq.REP) interoperate with our DEALER client.
+// Client: one DEALER socket connected to one server. Every wait has a timeout; a peer
+//   whose TCP connection drops while a reply is awaited is reported at once (socket
+//   monitor), naming the peer and its endpoint, instead of waiting for the timeout.
+// ZeroMQ sets TCP_NODELAY on its TCP sockets (no Nagle delay).
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace fsi::transport {
+
+class TransportError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+// No reply within the timeout.
+class TimeoutError : public TransportError {
+ public:
+  using TransportError::TransportError;
+};
+// The peer's connection dropped (process died, host gone).
+class PeerLostError : public TransportError {
+ public:
+  using TransportError::TransportError;
+};
+
+class Client {
+ public:
+  // `peer_name` names the peer in errors ("solid server").
+  Client(const std::string& endpoint, std::string peer_name);
+  ~Client();
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+
+  // Sends one message. Non-blocking up to `timeout` (high-water mark).
+  void send(const std::string& payload, std::chrono::milliseconds timeout);
+  // Waits for the next message. Throws TimeoutError / PeerLostError.
+  std::string receive(std::chrono::milliseconds timeout);
+  const std::string& endpoint() const { return endpoint_; }
+  const std::string& peer_name() const { return peer_name_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string endpoint_;
+  std::string peer_name_;
+};
+
+class Server {
+ public:
+  // `endpoint` e.g. "tcp://127.0.0.1:*" (a free port is picked) or "tcp://0.0.0.0:5555".
+  explicit Server(const std::string& endpoint);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+  // The endpoint actually bound, with the port resolved ("tcp://127.0.0.1:43817").
+  std::string endpoint() const;
+
+  // Handler returns the reply bytes; set `stop` to end serving after this reply.
+  using Handler = std::function<std::string(const std::string& request, bool& stop)>;
+  // Serves requests until a handler sets stop, or no request arrives for `idle_timeout`
+  // (zero = wait forever), or `should_stop()` returns true (polled every 200 ms).
+  // Returns false on idle timeout.
+  bool serve(const Handler& handler, std::chrono::milliseconds idle_timeout,
+             const std::function<bool()>& should_stop = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fsi::transport

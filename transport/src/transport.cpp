@@ -1,0 +1,147 @@
+#include "fsi/transport/transport.hpp"
+
+#include <zmq.hpp>
+
+#include <atomic>
+#include <cstring>
+#include <vector>
+
+namespace fsi::transport {
+namespace {
+
+zmq::context_t& context() {
+  static zmq::context_t ctx(1);
+  return ctx;
+}
+
+std::atomic<int> monitor_counter{0};
+
+}  // namespace
+
+struct Client::Impl {
+  zmq::socket_t socket{context(), zmq::socket_type::dealer};
+  zmq::socket_t monitor;
+  bool have_monitor = false;
+};
+
+Client::Client(const std::string& endpoint, std::string peer_name)
+    : impl_(std::make_unique<Impl>()), endpoint_(endpoint), peer_name_(std::move(peer_name)) {
+  try {
+    impl_->socket.set(zmq::sockopt::linger, 0);
+    const std::string mon = "inproc://fsi-client-monitor-" + std::to_string(monitor_counter++);
+    if (zmq_socket_monitor(impl_->socket.handle(), mon.c_str(), ZMQ_EVENT_DISCONNECTED) == 0) {
+      impl_->monitor = zmq::socket_t(context(), zmq::socket_type::pair);
+      impl_->monitor.set(zmq::sockopt::linger, 0);
+      impl_->monitor.connect(mon);
+      impl_->have_monitor = true;
+    }
+    impl_->socket.connect(endpoint);
+  } catch (const zmq::error_t& e) {
+    throw TransportError("cannot connect to " + peer_name_ + " at '" + endpoint + "': " + e.what());
+  }
+}
+
+Client::~Client() {
+  if (impl_ && impl_->have_monitor) zmq_socket_monitor(impl_->socket.handle(), nullptr, 0);
+}
+
+void Client::send(const std::string& payload, std::chrono::milliseconds timeout) {
+  zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLOUT, 0};
+  zmq::poll(&item, 1, timeout);
+  if (!(item.revents & ZMQ_POLLOUT))
+    throw TimeoutError("cannot send to " + peer_name_ + " at " + endpoint_ + " within " +
+                       std::to_string(timeout.count()) + " ms (not connected?)");
+  impl_->socket.send(zmq::message_t(), zmq::send_flags::sndmore);
+  impl_->socket.send(zmq::buffer(payload), zmq::send_flags::none);
+}
+
+std::string Client::receive(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0)
+      throw TimeoutError("no reply from " + peer_name_ + " at " + endpoint_ + " within " +
+                         std::to_string(timeout.count()) + " ms");
+    zmq::pollitem_t items[2] = {{impl_->socket.handle(), 0, ZMQ_POLLIN, 0},
+                                {impl_->have_monitor ? impl_->monitor.handle() : nullptr, 0, ZMQ_POLLIN, 0}};
+    zmq::poll(items, impl_->have_monitor ? 2 : 1, left);
+    if (items[0].revents & ZMQ_POLLIN) {
+      std::vector<zmq::message_t> frames;
+      while (true) {
+        zmq::message_t frame;
+        (void)impl_->socket.recv(frame, zmq::recv_flags::none);
+        const bool more = frame.more();
+        frames.push_back(std::move(frame));
+        if (!more) break;
+      }
+      // [ "", payload ] from ROUTER/REP; tolerate a missing delimiter.
+      const auto& last = frames.back();
+      return std::string(static_cast<const char*>(last.data()), last.size());
+    }
+    if (impl_->have_monitor && (items[1].revents & ZMQ_POLLIN)) {
+      zmq::message_t event, address;
+      (void)impl_->monitor.recv(event, zmq::recv_flags::none);
+      if (event.more()) (void)impl_->monitor.recv(address, zmq::recv_flags::none);
+      uint16_t id = 0;
+      if (event.size() >= sizeof(id)) std::memcpy(&id, event.data(), sizeof(id));
+      if (id == ZMQ_EVENT_DISCONNECTED)
+        throw PeerLostError(peer_name_ + " at " + endpoint_ +
+                            " closed the connection while a reply was awaited (process died?)");
+    }
+  }
+}
+
+struct Server::Impl {
+  zmq::socket_t socket{context(), zmq::socket_type::router};
+};
+
+Server::Server(const std::string& endpoint) : impl_(std::make_unique<Impl>()) {
+  try {
+    impl_->socket.set(zmq::sockopt::linger, 1000);
+    impl_->socket.bind(endpoint);
+  } catch (const zmq::error_t& e) {
+    throw TransportError("cannot bind '" + endpoint + "': " + e.what());
+  }
+}
+
+Server::~Server() = default;
+
+std::string Server::endpoint() const { return impl_->socket.get(zmq::sockopt::last_endpoint); }
+
+bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeout,
+                   const std::function<bool()>& should_stop) {
+  auto last_activity = std::chrono::steady_clock::now();
+  while (true) {
+    zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&item, 1, std::chrono::milliseconds(200));
+    if (should_stop && should_stop()) return true;
+    if (!(item.revents & ZMQ_POLLIN)) {
+      if (idle_timeout.count() > 0 && std::chrono::steady_clock::now() - last_activity > idle_timeout)
+        return false;
+      continue;
+    }
+    std::vector<zmq::message_t> frames;
+    while (true) {
+      zmq::message_t frame;
+      (void)impl_->socket.recv(frame, zmq::recv_flags::none);
+      const bool more = frame.more();
+      frames.push_back(std::move(frame));
+      if (!more) break;
+    }
+    last_activity = std::chrono::steady_clock::now();
+    if (frames.size() < 2) continue;  // no identity: cannot answer
+    // Envelope = every frame up to and including the empty delimiter (if present).
+    std::size_t payload_index = frames.size() - 1;
+    const std::string request(static_cast<const char*>(frames[payload_index].data()),
+                              frames[payload_index].size());
+    bool stop = false;
+    const std::string reply = handler(request, stop);
+    for (std::size_t i = 0; i < payload_index; ++i)
+      impl_->socket.send(zmq::buffer(frames[i].data(), frames[i].size()), zmq::send_flags::sndmore);
+    impl_->socket.send(zmq::buffer(reply), zmq::send_flags::none);
+    if (stop) return true;
+  }
+}
+
+}  // namespace fsi::transport
