@@ -1,0 +1,67 @@
+#pragma once
+// fsi::FluidModel for `fluid: {model: fem, ...}`: reads the scene keys (documented in
+// configs/dfg_2d1.yaml and docs/fluid.md), meshes the .geo with the gmsh CLI (cached),
+// runs NavierStokesSolver, moves the mesh by a harmonic extension of the interface
+// displacement, and reports drag/lift (consistent reactions), pressure probes, VTK.
+//
+// Call order (fsi::FluidModel): configure -> interface -> {solve_step ... accept_step} -> write_output.
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fsi/common/solver_model.hpp"
+#include "fsi/common/vtk_writer.hpp"
+#include "fsi/fluid/mesh_motion.hpp"
+#include "fsi/fluid/navier_stokes_solver.hpp"
+
+namespace fsi::fluid {
+
+// Runs `gmsh -2` on `geo` with `-setnumber name value` for every parameter, caching the
+// .msh in `cache_dir` under a name derived from the geo text and the parameters.
+std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
+                               const std::filesystem::path& cache_dir);
+
+class NavierStokesFluid : public FluidModel {
+ public:
+  NavierStokesFluid();
+  ~NavierStokesFluid() override;
+  std::string name() const override { return "fem"; }
+  void configure(const ConfigSection& section, const FluidSetup& setup) override;
+  InterfaceMeshData interface() const override;
+  FluidLoads initial_loads(const Eigen::VectorXd& interface_displacement,
+                           const Eigen::VectorXd& interface_velocity) override;
+  FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                        const Eigen::VectorXd& interface_velocity) override;
+  std::map<std::string, double> accept_step(const StepInfo& info) override;
+  std::vector<std::string> write_output(const StepInfo& info) override;
+
+  // For tests and benchmarks.
+  const NavierStokesSolver& solver() const { return *solver_; }
+  NavierStokesSolver& solver() { return *solver_; }
+  const StepReport& last_report() const { return last_report_; }
+
+ private:
+  struct ForceProbe {
+    std::string name;
+    std::vector<std::string> groups;
+    double coefficient_scale = 0;  // 2 / (rho U^2 L), 0 = no coefficients
+  };
+  FluidSetup setup_;
+  std::unique_ptr<NavierStokesSolver> solver_;
+  std::unique_ptr<MeshMotion> motion_;
+  std::vector<ForceProbe> forces_;
+  std::vector<std::pair<std::string, Eigen::Vector2d>> pressure_probes_;
+  std::vector<std::pair<std::string, std::pair<std::string, std::string>>> pressure_differences_;
+  int vtk_every_ = 0;
+  PvdSeries vtk_;
+  StepReport last_report_;
+  double solve_seconds_ = 0;
+  std::chrono::steady_clock::time_point start_, last_log_;
+  int solves_ = 0;
+};
+
+}  // namespace fsi::fluid

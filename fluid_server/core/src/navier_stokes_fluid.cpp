@@ -1,0 +1,358 @@
+#include "fsi/fluid/navier_stokes_fluid.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <regex>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "fsi/common/gmsh_reader.hpp"
+#include "fsi/common/log.hpp"
+
+namespace fsi::fluid {
+namespace {
+
+// Directory of the scene file that holds `key` (from "file:line:col" or "file (--set)").
+std::filesystem::path scene_directory(const ConfigSection& section, const std::string& key) {
+  std::string where = section.where(key);
+  const std::string set_suffix = " (--set)";
+  if (where.size() > set_suffix.size() && where.compare(where.size() - set_suffix.size(), set_suffix.size(), set_suffix) == 0)
+    where.resize(where.size() - set_suffix.size());
+  else
+    where = std::regex_replace(where, std::regex(":[0-9]+:[0-9]+$"), "");
+  return std::filesystem::path(where).parent_path();
+}
+
+// A path from the scene: absolute; else relative to the scene file; else to the working
+// directory; else to configs/ under the working directory.
+std::filesystem::path resolve_path(const ConfigSection& section, const std::string& key) {
+  const std::filesystem::path given = section.get<std::string>(key);
+  if (given.is_absolute()) {
+    if (!std::filesystem::exists(given)) section.fail(key, "file '" + given.string() + "' does not exist");
+    return given;
+  }
+  std::vector<std::filesystem::path> candidates = {scene_directory(section, key) / given, given,
+                                                   std::filesystem::path("configs") / given};
+  for (const auto& c : candidates)
+    if (std::filesystem::exists(c)) return std::filesystem::absolute(c);
+  std::string tried;
+  for (const auto& c : candidates) tried += (tried.empty() ? "" : ", ") + c.string();
+  section.fail(key, "file '" + given.string() + "' not found (tried " + tried + ")");
+}
+
+std::vector<std::string> string_list(const ConfigSection& section, const std::string& key) {
+  return section.get<std::vector<std::string>>(key, std::vector<std::string>{});
+}
+
+Eigen::Vector2d vector2(const ConfigSection& section, const std::string& key) {
+  const auto v = section.get<std::vector<double>>(key);
+  if (v.size() != 2) section.fail(key, fmt::format("must be a list of 2 numbers, got {}", v.size()));
+  return {v[0], v[1]};
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
+                               const std::filesystem::path& cache_dir) {
+  std::string key = read_text(geo);
+  for (const auto& [name, value] : parameters) key += fmt::format("\n{}={:.17g}", name, value);
+  const auto hash = std::hash<std::string>{}(key);
+  std::filesystem::create_directories(cache_dir);
+  const auto out = cache_dir / fmt::format("{}_{:016x}.msh", geo.stem().string(), hash);
+  if (std::filesystem::exists(out)) return out;
+  const auto tmp = cache_dir / fmt::format("{}_{:016x}.{}.tmp.msh", geo.stem().string(), hash, ::getpid());
+  const auto log_file = cache_dir / fmt::format("{}_{:016x}.log", geo.stem().string(), hash);
+  std::string cmd = "gmsh -2 -format msh22 -v 2";
+  for (const auto& [name, value] : parameters) cmd += fmt::format(" -setnumber {} {:.17g}", name, value);
+  cmd += fmt::format(" '{}' -o '{}' > '{}' 2>&1", geo.string(), tmp.string(), log_file.string());
+  fsi::logger("fluid")->info("meshing {} ({})", geo.filename().string(), cmd);
+  const int rc = std::system(cmd.c_str());
+  if (rc != 0 || !std::filesystem::exists(tmp))
+    throw std::runtime_error(fmt::format("gmsh failed on '{}' (exit {}): {}\n{}", geo.string(), rc, cmd, read_text(log_file)));
+  std::filesystem::rename(tmp, out);
+  return out;
+}
+
+NavierStokesFluid::NavierStokesFluid() = default;
+NavierStokesFluid::~NavierStokesFluid() = default;
+
+void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup& setup) {
+  auto log = fsi::logger("fluid");
+  setup_ = setup;
+  // --- mesh ---
+  const auto mesh_section = section.child("mesh");
+  std::filesystem::path msh;
+  if (mesh_section.has("file")) {
+    msh = resolve_path(mesh_section, "file");
+  } else {
+    const auto geo = resolve_path(mesh_section, "geo");
+    std::map<std::string, double> parameters;
+    parameters["h"] = mesh_section.get<double>("size");
+    if (!(parameters["h"] > 0)) mesh_section.fail("size", "must be positive");
+    if (auto extra = mesh_section.optional_child("parameters"))
+      for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
+    std::filesystem::path cache = setup.output_dir.empty() ? std::filesystem::temp_directory_path() / "fsi_fluid_meshes"
+                                                           : setup.output_dir / "meshes";
+    if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
+    msh = mesh_geo(geo, parameters, cache);
+  }
+  const auto domain = string_list(mesh_section, "domain");
+  FluidMesh mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
+
+  // --- physics and numerics ---
+  FlowParameters params;
+  params.density = section.get<double>("density");
+  params.viscosity = section.get<double>("viscosity");
+  if (!(params.density > 0)) section.fail("density", "must be positive");
+  if (!(params.viscosity > 0)) section.fail("viscosity", "must be positive");
+  const auto scheme = section.get<std::string>("scheme", "bdf2");
+  if (scheme == "bdf1") params.scheme = TimeScheme::BDF1;
+  else if (scheme == "bdf2") params.scheme = TimeScheme::BDF2;
+  else if (scheme == "steady") params.scheme = TimeScheme::Steady;
+  else section.fail("scheme", "must be bdf1, bdf2 or steady, got '" + scheme + "'");
+  if (auto nl = section.optional_child("nonlinear")) {
+    params.max_iterations = nl->get<int>("max_iterations", params.max_iterations);
+    params.tolerance = nl->get<double>("tolerance", params.tolerance);
+    if (params.max_iterations < 1) nl->fail("max_iterations", "must be at least 1");
+  }
+  if (params.scheme == TimeScheme::Steady && params.max_iterations == 1) params.max_iterations = 50;
+  if (auto st = section.optional_child("stabilisation")) {
+    auto& s = params.stabilisation;
+    s.supg = st->get<bool>("supg", s.supg);
+    s.pspg = st->get<bool>("pspg", s.pspg);
+    s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
+    s.viscous_constant = st->get<double>("viscous_constant", s.viscous_constant);
+    s.transient_tau = st->get<bool>("transient_tau", s.transient_tau);
+  }
+  params.threads = section.get<int>("threads", params.threads);
+  params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
+  if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
+
+  // Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's
+  // interface.penalty / interface.symmetry are used when the setup gives no penalty
+  // (standalone runs).
+  std::vector<std::string> interface_groups;
+  params.nitsche_penalty = setup.nitsche_penalty;
+  params.nitsche_symmetry = setup.nitsche_symmetry;
+  if (auto iface = section.optional_child("interface")) {
+    interface_groups = string_list(*iface, "groups");
+    const double penalty = iface->get<double>("penalty", setup.nitsche_penalty);
+    const double symmetry = iface->get<double>("symmetry", setup.nitsche_symmetry);
+    if (setup.nitsche_penalty == 0) {
+      params.nitsche_penalty = penalty;
+      params.nitsche_symmetry = symmetry;
+    } else if (penalty != setup.nitsche_penalty || symmetry != setup.nitsche_symmetry) {
+      log->warn("fluid.interface.penalty/symmetry ({}, {}) differ from the coupler's gamma_N1/gamma_N2 ({}, {}); "
+                "using the coupler's", penalty, symmetry, setup.nitsche_penalty, setup.nitsche_symmetry);
+    }
+    if (params.nitsche_penalty < 0) iface->fail("penalty", "gamma_N1 must be >= 0");
+    if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
+  }
+
+  solver_ = std::make_unique<NavierStokesSolver>(mesh, params);
+  auto& solver = *solver_;
+  const auto& fluid_mesh = solver.mesh();
+
+  // --- boundary conditions ---
+  std::vector<std::string> fixed_groups;
+  for (const auto& inflow : section.list("inflow")) {
+    const auto group = inflow.get<std::string>("group");
+    fixed_groups.push_back(group);
+    if (!fluid_mesh.has_boundary(group)) inflow.fail("group", "no boundary group '" + group + "' in " + msh.string());
+    const auto profile = inflow.get<std::string>("profile", "parabolic");
+    double umax = 0;
+    if (inflow.has("max_velocity")) umax = inflow.get<double>("max_velocity");
+    else if (inflow.has("mean_velocity")) umax = (profile == "parabolic" ? 1.5 : 1.0) * inflow.get<double>("mean_velocity");
+    else inflow.fail("max_velocity", "give max_velocity or mean_velocity");
+    const Eigen::Vector2d direction = inflow.has("direction") ? vector2(inflow, "direction").normalized() : Eigen::Vector2d(1, 0);
+    const double ramp = inflow.get<double>("ramp_time", 0.0);
+    // Extent of the inlet along its tangent.
+    const auto nodes = fluid_mesh.boundary_nodes({group});
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = Eigen::Vector2d::Constant(-1e300);
+    for (int i : nodes) {
+      lo = lo.cwiseMin(fluid_mesh.nodes.row(i).transpose());
+      hi = hi.cwiseMax(fluid_mesh.nodes.row(i).transpose());
+    }
+    const Eigen::Vector2d tangent = (hi - lo).normalized();
+    const double width = (hi - lo).norm();
+    std::function<double(double)> shape;
+    if (profile == "parabolic") shape = [](double s) { return 4 * s * (1 - s); };
+    else if (profile == "uniform") shape = [](double) { return 1.0; };
+    else inflow.fail("profile", "must be parabolic or uniform, got '" + profile + "'");
+    solver.add_dirichlet(group, [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
+      const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
+      const double factor = (ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0;
+      return umax * factor * shape(s) * direction;
+    });
+  }
+  for (const auto& g : string_list(section, "walls")) {
+    if (!fluid_mesh.has_boundary(g)) section.fail("walls", "no boundary group '" + g + "' in " + msh.string());
+    solver.add_dirichlet(g, [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
+    fixed_groups.push_back(g);
+  }
+  for (const auto& mw : section.list("moving_walls")) {
+    const auto g = mw.get<std::string>("group");
+    if (!fluid_mesh.has_boundary(g)) mw.fail("group", "no boundary group '" + g + "' in " + msh.string());
+    const Eigen::Vector2d v = vector2(mw, "velocity");
+    solver.add_dirichlet(g, [v](const Eigen::Vector2d&, double) { return v; });
+    fixed_groups.push_back(g);
+  }
+  for (const auto& g : string_list(section, "symmetry")) {
+    if (!fluid_mesh.has_boundary(g)) section.fail("symmetry", "no boundary group '" + g + "' in " + msh.string());
+    solver.add_symmetry(g);
+    fixed_groups.push_back(g);
+  }
+  for (const auto& g : string_list(section, "outlet")) {
+    if (!fluid_mesh.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh.string());
+    fixed_groups.push_back(g);
+  }
+  if (auto pr = section.optional_child("pressure_reference"))
+    solver.set_pressure_reference(vector2(*pr, "point"), [v = pr->get<double>("value", 0.0)](double) { return v; });
+  for (const auto& g : fluid_mesh.boundaries)
+    if (std::find(fixed_groups.begin(), fixed_groups.end(), g.first) == fixed_groups.end() &&
+        std::find(interface_groups.begin(), interface_groups.end(), g.first) == interface_groups.end())
+      log->warn("boundary group '{}' has no condition: it is a do-nothing boundary", g.first);
+  if (!interface_groups.empty()) {
+    for (const auto& g : interface_groups)
+      if (!fluid_mesh.has_boundary(g)) section.child("interface").fail("groups", "no boundary group '" + g + "'");
+    solver.set_interface(interface_groups);
+    motion_ = std::make_unique<MeshMotion>(fluid_mesh, solver.interface_nodes(), fluid_mesh.boundary_nodes(fixed_groups),
+                                           section.child("interface").get<double>("mesh_stiffening", 1.0));
+  }
+
+  // --- probes and output ---
+  for (const auto& f : section.list("forces")) {
+    ForceProbe probe;
+    probe.name = f.get<std::string>("name", "");
+    probe.groups = f.get<std::vector<std::string>>("groups");
+    for (const auto& g : probe.groups)
+      if (!fluid_mesh.has_boundary(g)) f.fail("groups", "no boundary group '" + g + "'");
+    if (f.has("reference_velocity")) {
+      const double u = f.get<double>("reference_velocity"), l = f.get<double>("reference_length");
+      probe.coefficient_scale = 2.0 / (params.density * u * u * l);
+    }
+    forces_.push_back(probe);
+  }
+  if (auto pp = section.optional_child("pressure_probes"))
+    for (const auto& k : pp->keys()) pressure_probes_.push_back({k, vector2(*pp, k)});
+  if (auto pd = section.optional_child("pressure_differences"))
+    for (const auto& k : pd->keys()) {
+      const auto pair = pd->get<std::vector<std::string>>(k);
+      if (pair.size() != 2) pd->fail(k, "must name two pressure probes [high, low]");
+      for (const auto& p : pair)
+        if (std::none_of(pressure_probes_.begin(), pressure_probes_.end(), [&](const auto& q) { return q.first == p; }))
+          pd->fail(k, "unknown pressure probe '" + p + "'");
+      pressure_differences_.push_back({k, {pair[0], pair[1]}});
+    }
+  if (auto out = section.optional_child("output")) vtk_every_ = out->get<int>("vtk_every", 0);
+  if (vtk_every_ > 0 && !setup.output_dir.empty()) vtk_ = PvdSeries(setup.output_dir, "fluid");
+
+  log->info("fluid: {} nodes, {} triangles, {} unknowns, scheme {}, {} interface nodes, mesh {}", fluid_mesh.node_count(),
+            fluid_mesh.triangle_count(), solver.dofs(), scheme, solver.interface_nodes().size(), msh.string());
+  start_ = last_log_ = std::chrono::steady_clock::now();
+}
+
+InterfaceMeshData NavierStokesFluid::interface() const {
+  InterfaceMeshData data;
+  const auto& nodes = solver_->interface_nodes();
+  data.coordinates.resize(static_cast<Eigen::Index>(nodes.size()), 2);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    data.node_ids.push_back(nodes[i]);
+    data.coordinates.row(static_cast<Eigen::Index>(i)) = solver_->mesh().nodes.row(nodes[i]);
+  }
+  const auto& seg = solver_->interface_segments();
+  for (Eigen::Index s = 0; s < seg.rows(); ++s) data.segments.push_back({seg(s, 0), seg(s, 1)});
+  return data;
+}
+
+FluidLoads NavierStokesFluid::initial_loads(const Eigen::VectorXd&, const Eigen::VectorXd&) {
+  FluidLoads loads;
+  loads.traction_force = solver_->interface_traction();
+  loads.velocity_integral = solver_->interface_velocity_integral();
+  return loads;
+}
+
+FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                                         const Eigen::VectorXd& interface_velocity) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Eigen::MatrixX2d positions = solver_->mesh().nodes;
+  if (motion_ && interface_displacement.size() > 0) positions += motion_->extend(interface_displacement);
+  try {
+    last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
+  } catch (const SolverError& e) {
+    throw SolverError(fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration,
+                                  e.what()));
+  }
+  solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++solves_;
+  FluidLoads loads;
+  loads.traction_force = solver_->interface_traction();
+  loads.velocity_integral = solver_->interface_velocity_integral();
+  loads.nonlinear_iterations = last_report_.iterations;
+  fsi::logger("fluid")->debug("step {} t={:.5g}: {} iteration(s), change {:.2e}, assembly {:.3f}s factor {:.3f}s",
+                              info.step, info.time, last_report_.iterations, last_report_.change,
+                              last_report_.assembly_seconds, last_report_.factor_seconds);
+  return loads;
+}
+
+std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
+  solver_->accept();
+  std::map<std::string, double> probes;
+  for (const auto& f : forces_) {
+    const Eigen::Vector2d force = solver_->force(f.groups);
+    const std::string prefix = f.name.empty() ? "" : f.name + "_";
+    probes[prefix + "drag"] = force.x();
+    probes[prefix + "lift"] = force.y();
+    if (f.coefficient_scale > 0) {
+      probes[prefix + "cd"] = f.coefficient_scale * force.x();
+      probes[prefix + "cl"] = f.coefficient_scale * force.y();
+    }
+  }
+  for (const auto& [name, point] : pressure_probes_) probes[name] = solver_->pressure_at(point);
+  for (const auto& [name, pair] : pressure_differences_) probes[name] = probes.at(pair.first) - probes.at(pair.second);
+  probes["nonlinear_iterations"] = last_report_.iterations;
+  probes["nonlinear_change"] = last_report_.change;
+
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_log_).count() > 5.0 || info.time >= setup_.end_time - 1e-12) {
+    last_log_ = now;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double done = setup_.end_time > 0 ? info.time / setup_.end_time : 1.0;
+    const double eta = done > 0 ? elapsed * (1 - done) / done : 0.0;
+    std::string extra;
+    for (const auto& [k, v] : probes)
+      if (k != "nonlinear_change" && k != "nonlinear_iterations") extra += fmt::format(" {}={:.6g}", k, v);
+    fsi::logger("fluid")->info("step {} t={:.4f}/{:.4g} ({:.0f}%) elapsed {:.1f}s ETA {:.1f}s |{}", info.step, info.time,
+                               setup_.end_time, 100 * done, elapsed, eta, extra);
+  }
+  return probes;
+}
+
+std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {
+  if (vtk_every_ <= 0 || setup_.output_dir.empty() || info.step % vtk_every_ != 0) return {};
+  const auto& mesh = solver_->mesh();
+  VtkGrid grid;
+  grid.points = solver_->positions();
+  for (int e = 0; e < mesh.triangle_count(); ++e) {
+    grid.cells.push_back({mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)});
+    grid.cell_types.push_back(VtkCellType::Triangle);
+  }
+  grid.point_data["velocity"] = solver_->velocity();
+  grid.point_data["pressure"] = solver_->pressure();
+  grid.point_data["mesh_displacement"] = solver_->positions() - mesh.nodes;
+  return {vtk_.write(info.time, info.step, grid).string()};
+}
+
+}  // namespace fsi::fluid
