@@ -29,23 +29,30 @@ struct Oscillation {
 };
 
 // Turek-Hron style: over the last full period, mean = (max + min)/2, amplitude =
-// (max - min)/2; frequency from the last two maxima (parabolic peak interpolation).
+// (max - min)/2; the period between the last two upward crossings of the mean (linear
+// interpolation, with hysteresis so that high-frequency ripple is not counted).
 Oscillation analyse(const std::vector<double>& t, const std::vector<double>& y) {
-  std::vector<double> peaks;
-  for (std::size_t i = 1; i + 1 < y.size(); ++i)
-    if (y[i] > y[i - 1] && y[i] >= y[i + 1]) {
-      const double a = y[i - 1], b = y[i], c = y[i + 1];
-      const double denom = a - 2 * b + c;
-      const double shift = denom != 0 ? 0.5 * (a - c) / denom : 0;
-      peaks.push_back(t[i] + shift * (t[i + 1] - t[i]));
-    }
   Oscillation o;
-  if (peaks.size() < 2) return o;
-  const double t0 = peaks[peaks.size() - 2], t1 = peaks.back();
-  o.frequency = 1.0 / (t1 - t0);
+  if (t.size() < 4) return o;
+  // Mean level from the second half of the record.
   double lo = 1e300, hi = -1e300;
+  for (std::size_t i = t.size() / 2; i < t.size(); ++i) lo = std::min(lo, y[i]), hi = std::max(hi, y[i]);
+  const double level = 0.5 * (hi + lo), band = 0.1 * (hi - lo);
+  std::vector<double> crossings;
+  bool below = false;
+  for (std::size_t i = 1; i < y.size(); ++i) {
+    if (y[i] < level - band) below = true;
+    if (below && y[i - 1] < level && y[i] >= level) {
+      crossings.push_back(t[i - 1] + (level - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]));
+      below = false;
+    }
+  }
+  if (crossings.size() < 2) return o;
+  const double t0 = crossings[crossings.size() - 2], t1 = crossings.back();
+  o.frequency = 1.0 / (t1 - t0);
+  lo = 1e300, hi = -1e300;
   for (std::size_t i = 0; i < t.size(); ++i)
-    if (t[i] >= t0 - 1e-12 && t[i] <= t1 + 1e-12) lo = std::min(lo, y[i]), hi = std::max(hi, y[i]);
+    if (t[i] >= t0 && t[i] <= t1) lo = std::min(lo, y[i]), hi = std::max(hi, y[i]);
   o.mean = 0.5 * (hi + lo);
   o.amplitude = 0.5 * (hi - lo);
   return o;

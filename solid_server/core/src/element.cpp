@@ -80,8 +80,8 @@ ElementState q4_internal_force(const ElementCoords& X, const ElementVector& u, c
     Eigen::Matrix<double, 4, 2> dNdX;
     const double detJ = reference_gradients(X, xi, eta, dNdX);
     out.min_det_jacobian = std::min(out.min_det_jacobian, detJ);
-    const Matrix2 F = Matrix2::Identity() + U * dNdX;
-    const Kinematics k = Kinematics::from_deformation_gradient(F);
+    const Kinematics k = Kinematics::from_displacement_gradient(U * dNdX);
+    const Matrix2& F = k.F;
     out.min_det_F = std::min(out.min_det_F, k.J);
     if (!(k.J > 0)) continue;  // the caller reports; keep values finite
     const Vector3 S = material.stress(k);

@@ -6,11 +6,16 @@
 namespace fsi::solid {
 
 Kinematics Kinematics::from_deformation_gradient(const Matrix2& F) {
+  return from_displacement_gradient(F - Matrix2::Identity());
+}
+
+Kinematics Kinematics::from_displacement_gradient(const Matrix2& H) {
   Kinematics k;
-  k.F = F;
-  k.C = F.transpose() * F;
-  k.E = 0.5 * (k.C - Matrix2::Identity());
-  k.J = F.determinant();
+  k.F = Matrix2::Identity() + H;
+  k.E = 0.5 * (H + H.transpose() + H.transpose() * H);
+  k.C = Matrix2::Identity() + 2.0 * k.E;
+  k.J_minus_1 = H.trace() + H.determinant();
+  k.J = 1.0 + k.J_minus_1;
   return k;
 }
 
@@ -57,13 +62,14 @@ double SaintVenantKirchhoff::energy(const Kinematics& k) const {
 
 Vector3 NeoHookean::stress(const Kinematics& k) const {
   const Matrix2 Ci = k.C.inverse();
-  const Matrix2 S = c_.mu * (Matrix2::Identity() - Ci) + c_.lambda * std::log(k.J) * Ci;
+  // mu (I - C^-1) = 2 mu C^-1 E, written so that small strains lose no digits.
+  const Matrix2 S = 2.0 * c_.mu * Ci * k.E + c_.lambda * std::log1p(k.J_minus_1) * Ci;
   return voigt(S);
 }
 
 Matrix3 NeoHookean::tangent(const Kinematics& k) const {
   const Matrix2 Ci = k.C.inverse();
-  const double lnJ = std::log(k.J);
+  const double lnJ = std::log1p(k.J_minus_1);
   const double mu_eff = c_.mu - c_.lambda * lnJ;
   Matrix3 D;
   for (int a = 0; a < 3; ++a)
@@ -76,7 +82,7 @@ Matrix3 NeoHookean::tangent(const Kinematics& k) const {
 }
 
 double NeoHookean::energy(const Kinematics& k) const {
-  const double lnJ = std::log(k.J);
+  const double lnJ = std::log1p(k.J_minus_1);
   return 0.5 * c_.mu * (k.C.trace() + 1.0 - 3.0) - c_.mu * lnJ + 0.5 * c_.lambda * lnJ * lnJ;
 }
 

@@ -21,7 +21,11 @@ using Matrix3 = Eigen::Matrix3d;
 struct Kinematics {
   Matrix2 F, C, E;
   double J = 1;
+  double J_minus_1 = 0;  // J - 1 without cancellation (tr H + det H)
   static Kinematics from_deformation_gradient(const Matrix2& F);
+  // From H = Grad u: E = (H + H^T + H^T H)/2 and J - 1 computed without the cancellation
+  // of F^T F - I, so that tiny strains (1e-10) keep full relative accuracy.
+  static Kinematics from_displacement_gradient(const Matrix2& H);
 };
 
 // Lame parameters for plane strain from either (E, nu) or (mu, nu).
