@@ -139,10 +139,10 @@ std::string ConfigSection::full_key(const std::string& key) const {
 
 YAML::Node ConfigSection::lookup(const std::string& key) const {
   state_->used.insert(full_key(key));
-  if (!node_.IsMap()) return YAML::Node();
-  for (const auto& kv : node_)
-    if (kv.first.Scalar() == key) return kv.second;
-  return YAML::Node();
+  if (node_.IsMap())
+    for (const auto& kv : node_)
+      if (kv.first.Scalar() == key) return kv.second;
+  return YAML::Node(YAML::NodeType::Undefined);  // tests false with operator!
 }
 
 bool ConfigSection::has(const std::string& key) const {

@@ -1,0 +1,100 @@
+// Scene files: unknown keys, wrong types and bad overrides are errors naming key and line.
+#include <gtest/gtest.h>
+
+#include "fsi/common/config.hpp"
+
+namespace {
+
+const char* kScene = R"(scene: t
+solid:
+  model: sdof
+  mass: 2.0
+  force: [1, 2]
+  nested:
+    depth: 3
+)";
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const fsi::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, ReadsValuesWithDefaults) {
+  auto scene = fsi::Scene::parse(kScene, "t.yaml");
+  auto solid = scene.section("solid");
+  EXPECT_EQ(solid.get<std::string>("model"), "sdof");
+  EXPECT_DOUBLE_EQ(solid.get<double>("mass"), 2.0);
+  EXPECT_DOUBLE_EQ(solid.get<double>("damping", 0.5), 0.5);
+  EXPECT_EQ(solid.get<std::vector<double>>("force"), (std::vector<double>{1, 2}));
+  EXPECT_EQ(solid.child("nested").get<int>("depth"), 3);
+  EXPECT_NO_THROW(scene.check_all_used("solid"));
+}
+
+TEST(Config, UnknownKeyNamesKeyAndLine) {
+  auto scene = fsi::Scene::parse(kScene, "t.yaml");
+  auto solid = scene.section("solid");
+  solid.get<std::string>("model");
+  solid.get<double>("mass");
+  solid.child("nested").get<int>("depth");
+  const auto msg = error_of([&] { scene.check_all_used("solid"); });
+  EXPECT_NE(msg.find("'solid.force'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("t.yaml:5"), std::string::npos) << msg;
+}
+
+TEST(Config, WrongTypeNamesKeyTypeAndLine) {
+  auto scene = fsi::Scene::parse("solid:\n  mass: heavy\n", "t.yaml");
+  const auto msg = error_of([&] { scene.section("solid").get<double>("mass"); });
+  EXPECT_NE(msg.find("t.yaml:2"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'solid.mass' must be a number"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("heavy"), std::string::npos) << msg;
+}
+
+TEST(Config, MissingRequiredKey) {
+  auto scene = fsi::Scene::parse("solid:\n  model: sdof\n", "t.yaml");
+  const auto msg = error_of([&] { scene.section("solid").get<double>("mass"); });
+  EXPECT_NE(msg.find("'solid.mass' is required"), std::string::npos) << msg;
+}
+
+TEST(Config, NotFiniteIsRejected) {
+  auto scene = fsi::Scene::parse("solid:\n  mass: .nan\n", "t.yaml");
+  EXPECT_NE(error_of([&] { scene.section("solid").get<double>("mass"); }).find("finite"), std::string::npos);
+}
+
+TEST(Config, OverridesReplaceAndAdd) {
+  auto scene = fsi::Scene::parse(kScene, "t.yaml", {"solid.mass=5", "solid.damping=0.25", "time.dt=0.1"});
+  EXPECT_DOUBLE_EQ(scene.section("solid").get<double>("mass"), 5.0);
+  EXPECT_DOUBLE_EQ(scene.section("solid").get<double>("damping"), 0.25);
+  EXPECT_DOUBLE_EQ(scene.section("time").get<double>("dt"), 0.1);
+  EXPECT_TRUE(scene.has("time.dt"));
+  EXPECT_FALSE(scene.has("time.end"));
+}
+
+TEST(Config, OverrideOfUnknownKeyIsReportedAsFromSet) {
+  auto scene = fsi::Scene::parse("solid:\n  mass: 1\n", "t.yaml", {"solid.masss=2"});
+  scene.section("solid").get<double>("mass");
+  const auto msg = error_of([&] { scene.check_all_used(); });
+  EXPECT_NE(msg.find("'solid.masss'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("--set"), std::string::npos) << msg;
+}
+
+TEST(Config, MalformedOverrideAndYaml) {
+  EXPECT_NE(error_of([] { fsi::Scene::parse("a: 1\n", "t.yaml", {"novalue"}); }).find("dotted.key=value"),
+            std::string::npos);
+  const auto msg = error_of([] { fsi::Scene::parse("a: [1, 2\nb: 3\n", "bad.yaml"); });
+  EXPECT_NE(msg.find("bad.yaml:"), std::string::npos) << msg;
+  EXPECT_NE(error_of([] { fsi::Scene::load("/nonexistent/scene.yaml"); }).find("cannot open"), std::string::npos);
+}
+
+TEST(Config, HasDoesNotModifyTheTree) {
+  auto scene = fsi::Scene::parse(kScene, "t.yaml");
+  EXPECT_TRUE(scene.has("solid.nested.depth"));
+  EXPECT_FALSE(scene.has("solid.nope"));
+  EXPECT_EQ(scene.section("solid").get<std::string>("model"), "sdof");
+  EXPECT_DOUBLE_EQ(scene.section("solid").get<double>("mass"), 2.0);
+}
+
+}  // namespace

@@ -1,0 +1,197 @@
+// The coupler with in-process models (no sockets): the seed paper's appendix recurrence,
+// the closed-form added-mass stability limits of Algorithms 1 and 2, and run outcomes.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "fsi/coupling/coupler.hpp"
+#include "fsi/models/sdof_solid.hpp"
+#include "fsi/models/surrogate_fluid.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  fsi::coupling::RunOutcome outcome;
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  std::vector<double> column(const std::string& name) const {
+    const auto it = std::find(columns.begin(), columns.end(), name);
+    EXPECT_NE(it, columns.end()) << name;
+    std::vector<double> out;
+    for (const auto& r : rows) out.push_back(r[it - columns.begin()]);
+    return out;
+  }
+};
+
+Run run_scene(const std::vector<std::string>& overrides) {
+  const auto scene = fsi::Scene::load(fs::path(FSI_SOURCE_DIR) / "configs/sdof_model.yaml", overrides);
+  const auto out = fs::temp_directory_path() / ("fsi_unit_" + std::to_string(::getpid()) + "_" +
+                                                std::to_string(std::hash<std::string>{}(
+                                                    [&] { std::string s; for (auto& o : overrides) s += o + ";"; return s; }())));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fsi::models::SdofSolid solid;
+  fsi::models::SurrogateFluid fluid;
+  fsi::RunReport report(out, scene, "test");
+  fsi::coupling::Coupler coupler(solid, fluid, scene, out);
+  Run run;
+  run.outcome = coupler.run(report);
+  std::ifstream in(out / "probes.csv");
+  std::string line;
+  if (std::getline(in, line)) {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) run.columns.push_back(c);
+  }
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::vector<double> row;
+    for (std::string c; std::getline(ss, c, ',');) row.push_back(std::stod(c));
+    run.rows.push_back(row);
+  }
+  fs::remove_all(out);
+  return run;
+}
+
+// The appendix recurrence m a_{n+1} + (c+g) v_{n+1} + k d_{n+1} = F + g v_n, BDF1.
+std::vector<double> recurrence(double gamma, int steps, double dt = 0.02) {
+  const double m = 1, c = 2.5, k = 10, F = 1.282;
+  double d = 0, v = 0;
+  std::vector<double> out;
+  for (int n = 0; n < steps; ++n) {
+    // m (d' - d - dt v)/dt^2 + (c+g)(d' - d)/dt + k d' = F + g v
+    const double dn = (F + gamma * v + m * (d / (dt * dt) + v / dt) + (c + gamma) * d / dt) /
+                      (m / (dt * dt) + (c + gamma) / dt + k);
+    v = (dn - d) / dt;
+    d = dn;
+    out.push_back(d);
+  }
+  return out;
+}
+
+// Time after which |d - F/k| stays within 2 % of F/k.
+double settling_time(const std::vector<double>& d, double dt) {
+  const double target = 0.1282;
+  for (int i = static_cast<int>(d.size()) - 1; i >= 0; --i)
+    if (std::abs(d[i] - target) > 0.02 * target) return (i + 1) * dt;
+  return 0;
+}
+
+class AppendixRecurrence : public ::testing::TestWithParam<double> {};
+
+TEST_P(AppendixRecurrence, Algorithm2MatchesTheBdf1RecurrenceToRoundOff) {
+  const double gamma = GetParam();
+  const auto run = run_scene({"coupling.gamma_n1=" + std::to_string(gamma)});
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  const auto d = run.column("solid.d_x");
+  const auto expected = recurrence(gamma, 500);
+  ASSERT_EQ(d.size(), expected.size());
+  for (std::size_t i = 0; i < d.size(); ++i) ASSERT_NEAR(d[i], expected[i], 1e-14) << "step " << i + 1;
+}
+
+INSTANTIATE_TEST_SUITE_P(Gammas, AppendixRecurrence, ::testing::Values(0.0, 1.0, 10.0, 100.0));
+
+TEST(Appendix, SettlesToFOverKLaterAsGammaGrows) {
+  double previous = 0;
+  for (double gamma : {0.0, 1.0, 10.0, 100.0}) {
+    // gamma = 100 is overdamped with a time constant ~ (c + gamma)/k = 10 s: run longer.
+    const auto run = run_scene({"coupling.gamma_n1=" + std::to_string(gamma), "time.end=80"});
+    ASSERT_EQ(run.outcome.status, "completed");
+    const auto d = run.column("solid.d_x");
+    EXPECT_NEAR(d.back(), 1.282 / 10, 1e-5) << "gamma " << gamma;
+    const double ts = settling_time(d, 0.02);
+    EXPECT_GT(ts, previous) << "gamma " << gamma;
+    previous = ts;
+  }
+}
+
+TEST(Appendix, Algorithm1IsIndependentOfGammaWhenVelocitiesMatch) {
+  const auto a = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0"}).column("solid.d_x");
+  const auto b = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=1000"}).column("solid.d_x");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-12);
+}
+
+// Pure added mass: solid m_s (with c, k), fluid added mass m_a. Relaxed iterations
+// F^(k+1) = -beta F* + (1-beta) F^(k) contract with factor
+//   Algorithm 1: 1 - beta (m_s + m_a) / m_eff,            m_eff = m + c dt + k dt^2
+//   Algorithm 2: 1 - beta (m_eff + m_a) / (m_eff + gamma mu dt)   (mu = interface measure)
+// so they converge iff beta < 2 m_eff / (m_eff + m_a), resp. 2 (m_eff + gamma dt) / (m_eff + m_a).
+double beta_limit(int algorithm, double gamma, double m, double c, double k, double m_a, double dt) {
+  const double m_eff = m + c * dt + k * dt * dt;
+  return 2 * (m_eff + (algorithm == 2 ? gamma * dt : 0.0)) / (m_eff + m_a);
+}
+
+struct AddedMassCase {
+  int algorithm;
+  double gamma;
+};
+
+class AddedMass : public ::testing::TestWithParam<AddedMassCase> {};
+
+TEST_P(AddedMass, ConvergesBelowAndDivergesAboveTheClosedFormLimit) {
+  const auto [algorithm, gamma] = GetParam();
+  const double m = 1, c = 0.5, k = 4, m_a = 10, dt = 0.01;
+  const double limit = beta_limit(algorithm, gamma, m, c, k, m_a, dt);
+  ASSERT_LT(1.1 * limit, 1.0) << "pick parameters with the limit below 1";
+  auto scene_for = [&](double beta) {
+    return std::vector<std::string>{
+        "coupling.algorithm=" + std::to_string(algorithm), "coupling.gamma_n1=" + std::to_string(gamma),
+        "coupling.relaxation=" + std::to_string(beta), "coupling.iterations.max=400",
+        "coupling.iterations.tolerance=1e-10", "time.end=0.2", "time.dt=" + std::to_string(dt),
+        "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"};
+  };
+  const auto below = run_scene(scene_for(0.9 * limit));
+  EXPECT_EQ(below.outcome.status, "completed") << below.outcome.reason;
+  const auto above = run_scene(scene_for(1.1 * limit));
+  EXPECT_EQ(above.outcome.status, "diverged");
+  EXPECT_EQ(above.outcome.steps, 0) << "the very first step must fail to converge";
+}
+
+INSTANTIATE_TEST_SUITE_P(Algorithms, AddedMass,
+                         ::testing::Values(AddedMassCase{1, 0.0}, AddedMassCase{1, 100.0}, AddedMassCase{2, 10.0},
+                                           AddedMassCase{2, 100.0}, AddedMassCase{2, 300.0}));
+
+TEST(AddedMass, ConvergedSolutionIsTheMonolithicOne) {
+  // Converged coupling iterations solve (m + m_a) a + c v + k d = F exactly (BDF1).
+  const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=0.1", "coupling.iterations.max=500",
+                              "coupling.iterations.tolerance=1e-12", "time.end=0.5", "time.dt=0.01",
+                              "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10",
+                              "fluid.force=1"});
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  double d = 0, v = 0;
+  const double M = 11, c = 0.5, k = 4, dt = 0.01;
+  const auto dx = run.column("solid.d_x");
+  for (std::size_t n = 0; n < dx.size(); ++n) {
+    const double dn = (1 + M * (d / (dt * dt) + v / dt) + c * d / dt) / (M / (dt * dt) + c / dt + k);
+    v = (dn - d) / dt;
+    d = dn;
+    ASSERT_NEAR(dx[n], d, 1e-10) << "step " << n + 1;
+  }
+}
+
+TEST(Outcome, LooselyCoupledBlowUpIsReportedAsDiverged) {
+  // Loosely coupled (k_max = 1, beta = 1) with m_a >> m_s grows without bound.
+  const auto run = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0", "fluid.added_mass=50",
+                              "coupling.force_limit=1e6", "time.end=10"});
+  EXPECT_EQ(run.outcome.status, "diverged");
+  EXPECT_NE(run.outcome.reason.find("force_limit"), std::string::npos) << run.outcome.reason;
+  EXPECT_GT(run.outcome.steps, 0);
+  EXPECT_EQ(run.rows.size(), static_cast<std::size_t>(run.outcome.steps)) << "every accepted step is on disk";
+}
+
+TEST(Outcome, UnknownCouplingKeyFailsWithItsName) {
+  const auto run = run_scene({"coupling.relaxaton=0.5"});
+  EXPECT_EQ(run.outcome.status, "failed");
+  EXPECT_NE(run.outcome.reason.find("coupling.relaxaton"), std::string::npos) << run.outcome.reason;
+}
+
+TEST(Outcome, OutOfRangeRelaxationIsRejected) {
+  const auto run = run_scene({"coupling.relaxation=1.5"});
+  EXPECT_EQ(run.outcome.status, "failed");
+  EXPECT_NE(run.outcome.reason.find("coupling.relaxation"), std::string::npos) << run.outcome.reason;
+}
+
+}  // namespace
