@@ -320,3 +320,15 @@ TEST(FemSolidGmsh, SameResultAsTheBuiltInRectangle) {
   EXPECT_NEAR(a.probes.at("tip_x"), b.probes.at("tip_x"), 1e-12);
   EXPECT_LT(a.probes.at("tip_y"), -1e-4);
 }
+
+// The committed gmsh flag (configs/meshes/csm_flag.msh, 160 x 8 quads from csm_flag.geo)
+// gives CSM1 exactly as the built-in 160 x 8 rectangle.
+TEST(FemSolidGmsh, CommittedFlagMeshMatchesRectangle) {
+  const auto path = repo_root() / "configs" / "csm1.yaml";
+  const auto gmsh = fsi::Scene::load(path, {"solid.output_every=0", "solid.mesh={type: gmsh, file: meshes/csm_flag.msh, domain: flag}",
+                                            "solid.clamp=clamped", "solid.interface=wet"});
+  const auto rect = fsi::Scene::load(path, {"solid.output_every=0", "solid.mesh.elements=[160, 8]"});
+  const auto a = run_scene(gmsh, 1, 1.0), b = run_scene(rect, 1, 1.0);
+  EXPECT_NEAR(a.probes.at("A_y"), b.probes.at("A_y"), 1e-10);
+  EXPECT_NEAR(a.probes.at("A_x"), b.probes.at("A_x"), 1e-10);
+}
