@@ -1,0 +1,39 @@
+// DFG 2D-1 (Schafer & Turek 1996, Re 20) through the scene file and NavierStokesFluid:
+// drag and pressure difference within 1 %, lift within 5 % of the reference values.
+#include <gtest/gtest.h>
+
+#include "fsi/common/config.hpp"
+#include "fsi/fluid/navier_stokes_fluid.hpp"
+
+namespace {
+
+TEST(DfgBenchmark, Dfg2d1WithinTolerances) {
+  auto scene = fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1.yaml", {"fluid.output.vtk_every=0"});
+  const auto fluid = scene.section("fluid");
+  ASSERT_EQ(fluid.get<std::string>("model"), "fem");
+  fsi::FluidSetup setup;
+  setup.dt = 1;
+  setup.end_time = 1;
+  fsi::fluid::NavierStokesFluid model;
+  model.configure(fluid, setup);
+  scene.check_all_used("fluid");
+  EXPECT_EQ(model.interface().nodes(), 0u);
+  const fsi::StepInfo info{1.0, 1.0, 1, 0};
+  model.solve_step(info, {}, {});
+  const auto probes = model.accept_step(info);
+  const double cd = probes.at("cd"), cl = probes.at("cl"), dp = probes.at("dp");
+  std::printf("DFG 2D-1: C_D %.5f (ref 5.57954, %.3f%%)  C_L %.6f (ref 0.0106189, %.2f%%)  dp %.5f (ref 0.117520, %.3f%%)\n",
+              cd, 100 * (cd / 5.57953523384 - 1), cl, 100 * (cl / 0.010618948146 - 1), dp, 100 * (dp / 0.11752016697 - 1));
+  EXPECT_NEAR(cd, 5.57953523384, 0.01 * 5.57953523384);
+  EXPECT_NEAR(cl, 0.010618948146, 0.05 * 0.010618948146);
+  EXPECT_NEAR(dp, 0.11752016697, 0.01 * 0.11752016697);
+}
+
+TEST(DfgBenchmark, UnknownSceneKeyIsRejected) {
+  auto scene = fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1.yaml",
+                                {"fluid.mesh.size=0.08", "fluid.scheme=bdf3"});
+  fsi::fluid::NavierStokesFluid model;
+  EXPECT_THROW(model.configure(scene.section("fluid"), fsi::FluidSetup{}), fsi::ConfigError);
+}
+
+}  // namespace
