@@ -176,7 +176,7 @@ std::vector<std::string> RemoteSolid::write_output(const StepInfo& info) {
 void RemoteSolid::stop(const std::string& reason) {
   fsi::v1::Request r;
   r.mutable_stop()->set_reason(reason);
-  client_->set_timeout(std::chrono::seconds(5));
+  client_->set_timeout(std::chrono::seconds(2));
   client_->call(r);
 }
 
@@ -248,7 +248,7 @@ std::vector<std::string> RemoteFluid::write_output(const StepInfo& info) {
 void RemoteFluid::stop(const std::string& reason) {
   fsi::v1::Request r;
   r.mutable_stop()->set_reason(reason);
-  client_->set_timeout(std::chrono::seconds(5));
+  client_->set_timeout(std::chrono::seconds(2));
   client_->call(r);
 }
 

@@ -16,12 +16,27 @@ zmq::context_t& context() {
 
 std::atomic<int> monitor_counter{0};
 
+// zmq::poll that treats a signal (EINTR) as "nothing ready": callers loop and re-check
+// their deadlines and stop flags.
+int poll_items(zmq::pollitem_t* items, std::size_t n, std::chrono::milliseconds timeout) {
+  try {
+    return zmq::poll(items, n, timeout);
+  } catch (const zmq::error_t& e) {
+    if (e.num() == EINTR) {
+      for (std::size_t i = 0; i < n; ++i) items[i].revents = 0;
+      return 0;
+    }
+    throw;
+  }
+}
+
 }  // namespace
 
 struct Client::Impl {
   zmq::socket_t socket{context(), zmq::socket_type::dealer};
   zmq::socket_t monitor;
   bool have_monitor = false;
+  bool lost = false;  // the peer disconnected while a reply was awaited
 };
 
 Client::Client(const std::string& endpoint, std::string peer_name)
@@ -46,8 +61,9 @@ Client::~Client() {
 }
 
 void Client::send(const std::string& payload, std::chrono::milliseconds timeout) {
+  if (impl_->lost) throw PeerLostError(peer_name_ + " at " + endpoint_ + " was lost earlier");
   zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLOUT, 0};
-  zmq::poll(&item, 1, timeout);
+  poll_items(&item, 1, timeout);
   if (!(item.revents & ZMQ_POLLOUT))
     throw TimeoutError("cannot send to " + peer_name_ + " at " + endpoint_ + " within " +
                        std::to_string(timeout.count()) + " ms (not connected?)");
@@ -65,7 +81,7 @@ std::string Client::receive(std::chrono::milliseconds timeout) {
                          std::to_string(timeout.count()) + " ms");
     zmq::pollitem_t items[2] = {{impl_->socket.handle(), 0, ZMQ_POLLIN, 0},
                                 {impl_->have_monitor ? impl_->monitor.handle() : nullptr, 0, ZMQ_POLLIN, 0}};
-    zmq::poll(items, impl_->have_monitor ? 2 : 1, left);
+    poll_items(items, impl_->have_monitor ? 2 : 1, left);
     if (items[0].revents & ZMQ_POLLIN) {
       std::vector<zmq::message_t> frames;
       while (true) {
@@ -85,9 +101,11 @@ std::string Client::receive(std::chrono::milliseconds timeout) {
       if (event.more()) (void)impl_->monitor.recv(address, zmq::recv_flags::none);
       uint16_t id = 0;
       if (event.size() >= sizeof(id)) std::memcpy(&id, event.data(), sizeof(id));
-      if (id == ZMQ_EVENT_DISCONNECTED)
+      if (id == ZMQ_EVENT_DISCONNECTED) {
+        impl_->lost = true;
         throw PeerLostError(peer_name_ + " at " + endpoint_ +
                             " closed the connection while a reply was awaited (process died?)");
+      }
     }
   }
 }
@@ -114,7 +132,7 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
   auto last_activity = std::chrono::steady_clock::now();
   while (true) {
     zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};
-    zmq::poll(&item, 1, std::chrono::milliseconds(200));
+    poll_items(&item, 1, std::chrono::milliseconds(200));
     if (should_stop && should_stop()) return true;
     if (!(item.revents & ZMQ_POLLIN)) {
       if (idle_timeout.count() > 0 && std::chrono::steady_clock::now() - last_activity > idle_timeout)

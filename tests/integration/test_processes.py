@@ -1,0 +1,205 @@
+#!/usr/bin/env python3
+"""Integration tests: the three processes over loopback (see harness.py)."""
+import math
+import os
+import signal
+import subprocess
+import time
+
+import zmq
+
+from harness import beta_limit, main, probes, recurrence, summary
+
+
+def end_to_end(env):
+    """fsi run sdof_model for gamma in {0, 1, 10, 100}: the BDF1 recurrence to round-off."""
+    for gamma in (0, 1, 10, 100):
+        out = env.out(f"sdof_g{gamma}")
+        code, log = env.fsi("sdof_model.yaml", out, f"coupling.gamma_n1={gamma}")
+        assert code == 0, log
+        s = summary(out)
+        assert s["status"] == "completed" and s["steps"] == 500 and s["coupling_iterations"] == 500, s
+        for key in ("solid_compute", "solid_messaging", "fluid_compute", "fluid_messaging", "total"):
+            assert key in s["wall_time"], s["wall_time"]
+        d = probes(os.path.join(out, "probes.csv"))["solid.d_x"]
+        ref = recurrence(gamma, 500)
+        err = max(abs(a - b) for a, b in zip(d, ref))
+        assert len(d) == 500 and err < 1e-14, (gamma, err)
+        with open(os.path.join(out, "iterations.csv")) as f:
+            assert len(f.readlines()) == 501
+        print(f"gamma={gamma}: max |d - recurrence| = {err:.2e}, d(10) = {d[-1]:.6f}")
+
+
+def python_solid(env):
+    """The Python solid in place of solid_server gives the same history to round-off."""
+    cpp, py = env.out("cpp"), env.out("py")
+    sets = ("coupling.gamma_n1=10",)
+    code, log = env.fsi("sdof_model.yaml", cpp, *sets)
+    assert code == 0, log
+    solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
+    code, log = env.fsi("sdof_model.yaml", py, *sets, extra=("--solid-command", solid))
+    assert code == 0, log
+    assert summary(py)["servers"]["solid"]["name"] == "python sdof_solid.py", summary(py)["servers"]
+    a, b = probes(os.path.join(cpp, "probes.csv")), probes(os.path.join(py, "probes.csv"))
+    for key in ("solid.d_x", "solid.v_x"):
+        err = max(abs(x - y) for x, y in zip(a[key], b[key]))
+        assert len(a[key]) == len(b[key]) == 500 and err <= 1e-15, (key, err)
+        print(f"{key}: max |C++ - Python| = {err:.1e}")
+
+
+def killed_server(env):
+    """A server killed mid-run: the coupler names it, exits non-zero within seconds, and
+    every accepted step is on disk."""
+    for victim in ("solid", "fluid"):
+        solid, solid_ep = env.start_server("solid")
+        fluid, fluid_ep = env.start_server("fluid")
+        out = env.out(f"killed_{victim}")
+        coupler = env.spawn([env.exe("coupler"), env.config("sdof_model.yaml"), "--solid", solid_ep, "--fluid",
+                             fluid_ep, "--out", out, "--set", "time.end=4000"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        probe_file = os.path.join(out, "probes.csv")
+        deadline = time.time() + 20
+        while time.time() < deadline and (not os.path.exists(probe_file) or os.path.getsize(probe_file) < 20000):
+            time.sleep(0.05)
+        assert coupler.poll() is None, "the coupler finished before the kill"
+        (solid if victim == "solid" else fluid).send_signal(signal.SIGKILL)
+        t0 = time.time()
+        try:
+            output, _ = coupler.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            raise AssertionError("the coupler did not notice the dead peer within 10 s")
+        elapsed = time.time() - t0
+        assert coupler.returncode not in (0, None), coupler.returncode
+        assert f"{victim} server" in output, output[-2000:]
+        s = summary(out)
+        assert s["status"] == "failed" and f"{victim} server" in s["reason"], s
+        rows = len(probes(probe_file)["time"])
+        assert rows == s["steps"] and rows > 100, (rows, s["steps"])
+        print(f"{victim} killed: coupler exited {coupler.returncode} after {elapsed:.2f} s with {rows} steps on disk; "
+              f"reason: {s['reason']}")
+        env.close()
+        env.procs.clear()
+
+
+def bad_messages(env):
+    """Malformed, wrong-version, out-of-order, wrong-size and NaN requests get error
+    replies; the server stays up and then serves a normal session."""
+    from fsi.v1 import coupling_pb2 as pb
+    server, endpoint = env.start_server("solid")
+    ctx = zmq.Context.instance()
+    sock = ctx.socket(zmq.REQ)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.setsockopt(zmq.RCVTIMEO, 5000)
+    sock.connect(endpoint)
+
+    def call(payload):
+        sock.send(payload if isinstance(payload, bytes) else payload.SerializeToString())
+        reply = pb.Reply()
+        reply.ParseFromString(sock.recv())
+        return reply
+
+    def request(seq, **kw):
+        r = pb.Request(protocol_version=1, sequence=seq)
+        for k, v in kw.items():
+            getattr(r, k).CopyFrom(v)
+        return r
+
+    def expect_error(reply, code, text):
+        assert reply.WhichOneof("body") == "error", reply
+        assert reply.error.code == code, reply
+        assert text in reply.error.message, reply.error.message
+        print(f"  {pb.Error.Code.Name(code)}: {reply.error.message}")
+
+    expect_error(call(b"\xff\x00garbage that is not protobuf\x13"), pb.Error.MALFORMED, "not a fsi.v1.Request")
+    r = request(1, hello=pb.Hello(client_name="t"))
+    r.protocol_version = 2
+    expect_error(call(r), pb.Error.VERSION_MISMATCH, "version")
+    expect_error(call(pb.Request(protocol_version=1, sequence=2)), pb.Error.MALFORMED, "no body")
+    step = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[1.0, 0.0])
+    expect_error(call(request(3, solve_step=step)), pb.Error.BAD_SEQUENCE, "before 'configure'")
+    with open(env.config("sdof_model.yaml")) as f:
+        text = f.read()
+    bad_cfg = pb.Configure(dt=0.02, end_time=1, scene_text=text, scene_path="sdof_model.yaml", section="solid",
+                           overrides=["solid.masss=3"])
+    expect_error(call(request(4, configure=bad_cfg)), pb.Error.INVALID_ARGUMENT, "solid.masss")
+    hello = call(request(5, hello=pb.Hello(client_name="t")))
+    assert hello.hello.kind == pb.SERVER_KIND_SOLID and hello.sequence == 5, hello
+    cfg = pb.Configure(dt=0.02, end_time=1, scene_text=text, scene_path="sdof_model.yaml", section="solid",
+                       interface_damping=10)
+    assert call(request(6, configure=cfg)).configure.interface_nodes == 1
+    wrong = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[1.0, 0.0, 3.0])
+    expect_error(call(request(7, solve_step=wrong)), pb.Error.INVALID_ARGUMENT, "has 3 values, expected 2")
+    nan = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[float("nan"), 0.0])
+    expect_error(call(request(8, solve_step=nan)), pb.Error.INVALID_ARGUMENT, "not finite")
+    ok = call(request(9, solve_step=step))
+    d = ok.solid_step.interface_displacement[0]
+    expected = 1.0 / (1 / 0.02 ** 2 + (2.5 + 10) / 0.02 + 10)
+    assert abs(d - expected) < 1e-15, (d, expected)
+    assert call(request(10, stop=pb.Stop(reason="done"))).WhichOneof("body") == "stop"
+    assert server.wait(timeout=5) == 0
+
+
+def added_mass(env):
+    """Pure added mass over loopback: converges below the closed-form limit of beta and is
+    reported as diverged above it, for Algorithm 1 and Algorithm 2 at several gamma."""
+    m, c, k, m_a, dt = 1.0, 0.5, 4.0, 10.0, 0.01
+    for algorithm, gamma in ((1, 0), (1, 100), (2, 10), (2, 100), (2, 300)):
+        limit = beta_limit(algorithm, gamma, m, c, k, m_a, dt)
+        for factor, want_code, want in ((0.9, 0, "completed"), (1.1, 2, "diverged")):
+            out = env.out(f"am_{algorithm}_{gamma}_{factor}")
+            code, log = env.fsi("added_mass.yaml", out, f"coupling.algorithm={algorithm}",
+                                f"coupling.gamma_n1={gamma}", f"coupling.relaxation={factor * limit}")
+            s = summary(out)
+            assert code == want_code and s["status"] == want, (algorithm, gamma, factor, code, s["status"], s["reason"])
+        print(f"algorithm {algorithm}, gamma {gamma}: beta limit {limit:.4f}: 0.9x converged, 1.1x diverged "
+              f"({s['reason'][:60]}...)")
+
+
+def config_errors(env):
+    """Bad scenes fail early with the key and the line, and a non-zero exit."""
+    code, log = env.fsi("sdof_model.yaml", env.out("typo"), "solid.masss=3")
+    assert code != 0 and "solid.masss" in log, log
+    bad = env.out("not_a_scene.yaml")
+    with open(bad, "w") as f:
+        f.write("solid: [1, 2\n  fluid: }\n")
+    code, log = env.run([env.exe("fsi"), "run", bad, "--out", env.out("bad")])
+    assert code != 0 and "not_a_scene.yaml:" in log, log
+    code, log = env.fsi("sdof_model.yaml", env.out("type"), "coupling.relaxation=fast")
+    assert code != 0 and "'coupling.relaxation' must be a number" in log, log
+    print("config errors reported:", [l for l in log.splitlines() if "relaxation" in l][-1][-90:])
+
+
+def interrupt(env):
+    """Ctrl-C on the launcher stops every process it started; the summary says so."""
+    out = env.out("interrupted")
+    p = env.spawn([env.exe("fsi"), "run", env.config("sdof_model.yaml"), "--out", out, "--set", "time.end=4000"],
+                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    probe_file = os.path.join(out, "probes.csv")
+    deadline = time.time() + 20
+    while time.time() < deadline and not os.path.exists(probe_file):
+        time.sleep(0.05)
+    time.sleep(0.3)
+    p.send_signal(signal.SIGINT)
+    try:
+        p.communicate(timeout=15)
+    except subprocess.TimeoutExpired:
+        raise AssertionError("the launcher did not stop within 15 s of Ctrl-C")
+    assert p.returncode != 0
+    s = summary(out)
+    assert s["status"] == "failed" and "interrupted" in s["reason"], s
+    leftovers = []
+    for pid in os.listdir("/proc"):
+        if pid.isdigit():
+            try:
+                with open(f"/proc/{pid}/cmdline", "rb") as f:
+                    if out.encode() in f.read():
+                        leftovers.append(pid)
+            except OSError:
+                pass
+    assert not leftovers, f"processes left running: {leftovers}"
+    print(f"interrupted after {s['steps']} steps; no process left")
+
+
+if __name__ == "__main__":
+    main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, added_mass, config_errors,
+                                  interrupt)})
