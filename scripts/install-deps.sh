@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages this project needs, only those missing. Idempotent.
+set -euo pipefail
+packages=(
+  build-essential cmake ninja-build git pkg-config
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread
+  libprotobuf-dev protobuf-compiler libzmq3-dev cppzmq-dev
+  libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libgtest-dev
+  gmsh
+  python3 python3-zmq python3-protobuf python3-yaml python3-matplotlib
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
