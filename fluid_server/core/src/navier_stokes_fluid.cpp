@@ -139,6 +139,11 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
   params.threads = section.get<int>("threads", params.threads);
   params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
   if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
+  if (auto ls = section.optional_child("linear_solver")) {
+    params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
+    params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
+    params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
+  }
 
   // Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's
   // interface.penalty / interface.symmetry are used when the setup gives no penalty
@@ -301,9 +306,12 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   loads.traction_force = solver_->interface_traction();
   loads.velocity_integral = solver_->interface_velocity_integral();
   loads.nonlinear_iterations = last_report_.iterations;
-  fsi::logger("fluid")->debug("step {} t={:.5g}: {} iteration(s), change {:.2e}, assembly {:.3f}s factor {:.3f}s",
+  factorisations_ += last_report_.factorisations;
+  fsi::logger("fluid")->debug("step {} t={:.5g}: {} iteration(s), change {:.2e}, assembly {:.3f}s, {} factorisation(s) "
+                              "{:.3f}s, {} BiCGSTAB iterations, solve {:.3f}s",
                               info.step, info.time, last_report_.iterations, last_report_.change,
-                              last_report_.assembly_seconds, last_report_.factor_seconds);
+                              last_report_.assembly_seconds, last_report_.factorisations, last_report_.factor_seconds,
+                              last_report_.krylov_iterations, last_report_.solve_seconds);
   return loads;
 }
 
@@ -324,6 +332,7 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
   for (const auto& [name, pair] : pressure_differences_) probes[name] = probes.at(pair.first) - probes.at(pair.second);
   probes["nonlinear_iterations"] = last_report_.iterations;
   probes["nonlinear_change"] = last_report_.change;
+  probes["factorisations"] = factorisations_;
 
   const auto now = std::chrono::steady_clock::now();
   if (std::chrono::duration<double>(now - last_log_).count() > 5.0 || info.time >= setup_.end_time - 1e-12) {
@@ -333,7 +342,7 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
     const double eta = done > 0 ? elapsed * (1 - done) / done : 0.0;
     std::string extra;
     for (const auto& [k, v] : probes)
-      if (k != "nonlinear_change" && k != "nonlinear_iterations") extra += fmt::format(" {}={:.6g}", k, v);
+      if (k != "nonlinear_change" && k != "nonlinear_iterations" && k != "factorisations") extra += fmt::format(" {}={:.6g}", k, v);
     fsi::logger("fluid")->info("step {} t={:.4f}/{:.4g} ({:.0f}%) elapsed {:.1f}s ETA {:.1f}s |{}", info.step, info.time,
                                setup_.end_time, 100 * done, elapsed, eta, extra);
   }

@@ -62,6 +62,7 @@ class NavierStokesFluid : public FluidModel {
   double solve_seconds_ = 0;
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
+  int factorisations_ = 0;  // cumulative
 };
 
 }  // namespace fsi::fluid

@@ -41,6 +41,11 @@ struct FlowParameters {
   double nitsche_symmetry = -1;  // gamma_N2 (+1 symmetric, -1 unsymmetric)
   int threads = 2;
   int umfpack_irstep = 1;
+  // Reuse the last LU factors as the preconditioner of BiCGSTAB on the new matrix; refactorise
+  // only when BiCGSTAB needs more than krylov_max_iterations (or on the first solve).
+  bool reuse_factorisation = true;
+  double krylov_tolerance = 1e-10;  // relative residual
+  int krylov_max_iterations = 25;
 };
 
 struct StepReport {
@@ -49,6 +54,8 @@ struct StepReport {
   double assembly_seconds = 0;
   double factor_seconds = 0;
   double solve_seconds = 0;
+  int factorisations = 0;
+  int krylov_iterations = 0;
 };
 
 class NavierStokesSolver {
