@@ -100,8 +100,11 @@ TEST(PatchTest, UniformStressOnDistortedMesh) {
   // Corner nodes are shared with top/bottom: subtract their half-edge share of those faces.
   for (int node : {4, 24}) right_total -= 0.5 * 0.25 * P * (node == 4 ? Eigen::Vector2d(0, -1) : Eigen::Vector2d(0, 1));
   EXPECT_LT((right_total - P.col(0)).norm(), 1e-12);
-  for (int i = 0; i < n; ++i)
-    if (!fixed[2 * i]) EXPECT_LT(f.segment<2>(2 * i).norm(), 1e-13) << "interior node " << i;
+  for (int i = 0; i < n; ++i) {
+    if (!fixed[2 * i]) {
+      EXPECT_LT(f.segment<2>(2 * i).norm(), 1e-13) << "interior node " << i;
+    }
+  }
 
   // (b) Newton from zero interior displacement.
   Eigen::VectorXd d = Eigen::VectorXd::Zero(2 * n);
