@@ -118,9 +118,13 @@ std::string wait_for_endpoint(Child& c, const fs::path& port_file, std::chrono::
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
     if (g_signal) throw std::runtime_error("interrupted while starting " + c.name);
+    // Complete only with its trailing newline (a writer that is not atomic may be mid-way).
     std::ifstream in(port_file);
-    std::string endpoint;
-    if (in && std::getline(in, endpoint) && !endpoint.empty()) return endpoint;
+    std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!content.empty() && content.back() == '\n') {
+      const std::string endpoint = content.substr(0, content.find('\n'));
+      if (!endpoint.empty()) return endpoint;
+    }
     reap(c, false);
     if (!c.alive())
       throw std::runtime_error(fmt::format("{} exited with code {} before listening; its log ({}):\n{}", c.name,

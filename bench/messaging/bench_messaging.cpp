@@ -31,6 +31,7 @@
 #include <thread>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/process.hpp"
 #include "fsi/protocol/remote.hpp"
 #include "fsi/protocol/service.hpp"
 #include "fsi/transport/transport.hpp"
@@ -433,6 +434,7 @@ void write_out(const std::string& path, const std::vector<Row>& rows) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  fsi::init_process();  // as the real executables do
   // 1. Parse options.
   CLI::App app{"Messaging cost per coupling iteration (solid + fluid round trip over tcp loopback)"};
   std::vector<int> nodes{100, 1000, 10000}, iterations{2000, 2000, 300};

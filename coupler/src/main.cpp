@@ -12,6 +12,7 @@
 #include <csignal>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/process.hpp"
 #include "fsi/common/run_report.hpp"
 #include "fsi/coupling/coupler.hpp"
 #include "fsi/protocol/remote.hpp"
@@ -21,6 +22,7 @@ extern "C" void on_signal(int) { fsi::coupling::Coupler::interrupt_flag() = true
 }  // namespace
 
 int main(int argc, char** argv) {
+  fsi::init_process();
   // 1. Parse options.
   CLI::App app{"FSI coupler"};
   std::string scene_path, solid_endpoint, fluid_endpoint, out_dir = "out";

@@ -8,11 +8,13 @@
 #include <CLI/CLI.hpp>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/process.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/models/solid_factory.hpp"
 #include "fsi/protocol/service.hpp"
 
 int main(int argc, char** argv) {
+  fsi::init_process();
   // 1. Parse options.
   CLI::App app{"FSI solid server"};
   std::string bind = "tcp://127.0.0.1:5555", port_file, scene_path, out_dir = "out/solid";

@@ -102,6 +102,10 @@ std::string Client::receive(std::chrono::milliseconds timeout) {
       uint16_t id = 0;
       if (event.size() >= sizeof(id)) std::memcpy(&id, event.data(), sizeof(id));
       if (id == ZMQ_EVENT_DISCONNECTED) {
+        // A peer that replies and exits at once (Stop) may disconnect before its reply is
+        // delivered to this socket: give the reply a short grace period.
+        zmq::pollitem_t last{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};
+        if (poll_items(&last, 1, std::chrono::milliseconds(100)) > 0 && (last.revents & ZMQ_POLLIN)) continue;
         impl_->lost = true;
         throw PeerLostError(peer_name_ + " at " + endpoint_ +
                             " closed the connection while a reply was awaited (process died?)");
