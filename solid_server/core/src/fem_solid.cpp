@@ -150,7 +150,7 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   }
   system_ = std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind);
 
-  // 6. Loads: gravity (force per reference volume rho_s g) and dead edge tractions.
+  // 6. Loads: gravity (force per reference volume rho_s g), dead edge tractions, point loads.
   const Eigen::Vector2d gravity = vec2(s, "gravity", Eigen::Vector2d::Zero());
   dead_load_ = system_->body_force(Eigen::Vector2d(density * gravity));
   for (const auto& t : s.list("tractions")) {
@@ -166,6 +166,14 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
       const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
       for (int n : e) dead_load_.segment<2>(2 * n) += 0.5 * L * traction;
     }
+  }
+
+  for (const auto& p : s.list("point_loads")) {  // force at the node nearest to a point
+    const Eigen::Vector2d point = vec2(p, "point");
+    const Eigen::Vector2d force = vec2(p, "force");
+    Eigen::Index nearest = 0;
+    (mesh_.nodes.rowwise() - point.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
+    dead_load_.segment<2>(2 * nearest) += force;
   }
 
   // 7. Interface: named edges -> InterfaceMeshData; Algorithm 2 damping on them.
@@ -217,10 +225,9 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
     probes_.push_back(probe);
   }
 
-  output_every_ = s.get<int>("output_every", 1);
-  if (output_every_ < 0) s.fail("output_every", "must be >= 0 (0 = never)");
+  // VTK goes to the run's output folder whenever the driver/coupler asks (time.output_every).
   series_.reset();
-  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid");
+  if (!setup.output_dir.empty()) series_.emplace(setup.output_dir, "solid");
 
   // 9. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
   const int n = system_->num_dofs();
@@ -334,7 +341,7 @@ std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
 }
 
 std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
-  if (!series_ || output_every_ <= 0 || info.step % output_every_ != 0) return {};
+  if (!series_) return {};
   VtkGrid grid;
   grid.points = mesh_.nodes;
   const int nn = mesh_.num_nodes(), nc = mesh_.num_cells();
