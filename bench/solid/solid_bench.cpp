@@ -4,7 +4,7 @@
 //   build/bin/solid_bench run configs/csm1.yaml                      # static: final A_x, A_y
 //   build/bin/solid_bench run configs/csm3.yaml                      # dynamic: mean/amplitude/frequency
 //   build/bin/solid_bench run configs/csm3.yaml solid.time_scheme=bdf1
-//   build/bin/solid_bench timing                                     # Newton iteration / step timings
+//   build/bin/solid_bench timing [cholmod|umfpack]                   # Newton iteration / step timings
 // Extra arguments key=value override scene keys (as the solid_server's --set).
 #include <Eigen/Core>
 #include <fmt/format.h>
@@ -110,7 +110,7 @@ double median(std::vector<double> v) {
 
 // Median timings of one Newton iteration (assembly + factorisation + solve) and of one
 // dynamic step on the paper's beam meshes.
-int timing() {
+int timing(const std::string& linear_solver) {
   struct Case {
     const char* name;
     int nx, ny;
@@ -127,7 +127,8 @@ solid:
   time_scheme: bdf1
   clamp: bottom
   interface: [left, top, right]
-)", c.nx, c.ny);
+  linear_solver: {}
+)", c.nx, c.ny, linear_solver);
     auto scene = fsi::Scene::parse(text, "timing");
     fsi::SolidSetup setup{0.01, 1.0, 0.0, {}};
     fsi::solid::FemSolid solid;
@@ -155,9 +156,9 @@ solid:
       factor_ms.push_back(std::chrono::duration<double, std::milli>(a2 - a1).count());
       iter_ms.push_back(std::chrono::duration<double, std::milli>(a2 - a0).count());
     }
-    fmt::print("mesh {} ({} free dofs): Newton iteration {:.3f} ms (assembly {:.3f} + factorise/solve {:.3f}), "
+    fmt::print("[{}] mesh {} ({} free dofs): Newton iteration {:.3f} ms (assembly {:.3f} + factorise/solve {:.3f}), "
                "step {:.3f} ms ({:.1f} iterations/step), medians of 40\n",
-               c.name, solid.system().num_free(), median(iter_ms), median(assemble_ms), median(factor_ms),
+               linear_solver, c.name, solid.system().num_free(), median(iter_ms), median(assemble_ms), median(factor_ms),
                median(step_ms), iterations / 40.0);
   }
   return 0;
@@ -169,8 +170,8 @@ int main(int argc, char** argv) {
   try {
     const std::string mode = argc > 1 ? argv[1] : "";
     if (mode == "run" && argc > 2) return run(argv[2], std::vector<std::string>(argv + 3, argv + argc));
-    if (mode == "timing") return timing();
-    std::fprintf(stderr, "usage: solid_bench run SCENE [key=value ...] | solid_bench timing\n");
+    if (mode == "timing") return timing(argc > 2 ? argv[2] : "cholmod");
+    std::fprintf(stderr, "usage: solid_bench run SCENE [key=value ...] | solid_bench timing [cholmod|umfpack]\n");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
