@@ -185,3 +185,27 @@ TEST(SolidSystem, InvertedElementIsReported) {
     EXPECT_LT(e.det_F, 0);
   }
 }
+
+// CHOLMOD is tried first; an indefinite matrix makes the solver switch to UMFPACK.
+TEST(SparseDirectSolver, FallsBackToUmfpackOnIndefiniteMatrix) {
+  SparseMatrix A(3, 3);
+  A.insert(0, 0) = 2;
+  A.insert(1, 1) = -1;
+  A.insert(2, 2) = 3;
+  A.insert(0, 2) = 1;
+  A.insert(2, 0) = 1;
+  A.makeCompressed();
+  SparseDirectSolver solver(LinearSolverKind::Cholmod);
+  solver.factorize(A);
+  EXPECT_EQ(solver.kind(), LinearSolverKind::Umfpack);
+  const Eigen::Vector3d b(1, 2, 3);
+  EXPECT_LT((A * solver.solve(b) - b).norm(), 1e-12);
+  // SPD stays with CHOLMOD, and refactorising the same pattern works.
+  A.coeffRef(1, 1) = 4;
+  SparseDirectSolver spd(LinearSolverKind::Cholmod);
+  spd.factorize(A);
+  A.coeffRef(1, 1) = 5;
+  spd.factorize(A);
+  EXPECT_EQ(spd.kind(), LinearSolverKind::Cholmod);
+  EXPECT_LT((A * spd.solve(b) - b).norm(), 1e-12);
+}
