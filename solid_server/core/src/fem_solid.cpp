@@ -225,9 +225,12 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
     probes_.push_back(probe);
   }
 
-  // VTK goes to the run's output folder whenever the driver/coupler asks (time.output_every).
+  // VTK goes to the run's output folder when the driver/coupler asks (time.output_every) and
+  // the step is a multiple of solid.output_every (default 1; 0 = the solid writes nothing).
+  output_every_ = s.get<int>("output_every", 1);
+  if (output_every_ < 0) s.fail("output_every", "must be >= 0 (0 = never)");
   series_.reset();
-  if (!setup.output_dir.empty()) series_.emplace(setup.output_dir, "solid");
+  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid");
 
   // 9. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
   const int n = system_->num_dofs();
@@ -341,7 +344,7 @@ std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
 }
 
 std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
-  if (!series_) return {};
+  if (!series_ || info.step % output_every_ != 0) return {};
   VtkGrid grid;
   grid.points = mesh_.nodes;
   const int nn = mesh_.num_nodes(), nc = mesh_.num_cells();

@@ -68,6 +68,7 @@ class FemSolid : public fsi::SolidModel {
   std::vector<int> interface_nodes_;     // global node ids
   InterfaceMeshData interface_;
   std::vector<Probe> probes_;
+  int output_every_ = 1;
   std::optional<PvdSeries> series_;
   // Accepted (n) and trial (n+1) states.
   Eigen::VectorXd d_n_, v_n_, a_n_, f_n_;
