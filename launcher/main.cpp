@@ -212,6 +212,30 @@ int run(const std::string& scene_path, const std::string& out_dir, const std::ve
   return code;
 }
 
+// `fsi study`: hands the sweep to tools/fsi_study.py (Debian's python3), passing this executable
+// as --fsi so every run uses the same build. Replaces this process; returns only on failure.
+int study(const std::string& study_file, const std::string& out_dir, int jobs) {
+#ifdef FSI_SOURCE_DIR
+  fs::path tool = fs::path(FSI_SOURCE_DIR) / "tools" / "fsi_study.py";
+#else
+  fs::path tool;
+#endif
+  if (tool.empty() || !fs::exists(tool)) tool = self_dir() / ".." / ".." / "tools" / "fsi_study.py";
+  if (!fs::exists(tool)) {
+    fsi::logger("fsi")->error("study tool not found: {}", tool.string());
+    return 1;
+  }
+  const std::string self = fs::read_symlink("/proc/self/exe").string();
+  std::vector<std::string> args{"/usr/bin/python3", tool.string(), "run", study_file, "--out", out_dir, "--fsi", self};
+  if (jobs > 0) args.insert(args.end(), {"--jobs", std::to_string(jobs)});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  execv(argv[0], argv.data());
+  fsi::logger("fsi")->error("cannot start {}: {}", argv[0], std::strerror(errno));
+  return 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -228,7 +252,14 @@ int main(int argc, char** argv) {
                       "start this external solid instead of solid_server (gets --bind and --port-file)");
   run_cmd->add_option("--fluid-command", fluid_command, "start this external fluid instead of fluid_server");
   run_cmd->add_option("--timeout", timeout, "seconds the coupler waits for any single reply");
+  auto* study_cmd = app.add_subcommand("study", "run a parameter study (tools/fsi_study.py run; docs/studies.md)");
+  std::string study_file, study_out = "runs/study";
+  int jobs = 0;
+  study_cmd->add_option("study", study_file, "study file (studies/*.yaml)")->required()->check(CLI::ExistingFile);
+  study_cmd->add_option("--out", study_out, "study folder (results.csv, results.json, runs/)");
+  study_cmd->add_option("--jobs", jobs, "parallel runs (default: number of cores)");
   CLI11_PARSE(app, argc, argv);
+  if (study_cmd->parsed()) return study(study_file, study_out, jobs);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
