@@ -24,7 +24,6 @@ import json
 import math
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -122,11 +121,11 @@ def time_mean(t, y):
 
 
 def zero_crossing_frequency(t, y):
-    """Frequency from the upward zero crossings of the linearly detrended signal."""
+    """Frequency from the upward crossings of the time-mean: (crossings - 1) / (last - first),
+    crossing times interpolated linearly."""
     if len(t) < 4:
         return None
-    coef = np.polyfit(t - t[0], y, 1)
-    z = y - np.polyval(coef, t - t[0])
+    z = y - time_mean(t, y)
     scale = np.max(np.abs(z)) if len(z) else 0.0
     if not scale > 0:
         return None
@@ -177,33 +176,38 @@ def signal_metrics(t, y, window=None, steady_fraction=0.1):
 
 
 def phase_lag(t, y, tr, yr, max_lag=None):
-    """Time lag of y behind yr (y(t) ~ yr(t - lag)) from the cross-correlation of the detrended
-    signals on a common uniform grid, refined parabolically. Positive: y lags the reference."""
+    """Time lag of y behind the reference yr: the shift s minimising the mean square of
+    y(t) - yr(t - s) over the overlap (for zero-mean periodic signals: the cross-correlation
+    peak), on a uniform grid of at most 4000 samples, refined parabolically. Positive: y lags.
+    max_lag: the search range (default: a quarter of the overlap)."""
     a, b = max(t[0], tr[0]), min(t[-1], tr[-1])
     if not b > a:
         return None
     dt = min(np.min(np.diff(t)) if len(t) > 1 else b - a, np.min(np.diff(tr)) if len(tr) > 1 else b - a)
-    n = int(min(max((b - a) / max(dt, 1e-300), 16), 200000)) + 1
+    n = int(min(max((b - a) / max(dt, 1e-300), 16), 4000)) + 1
     tu = np.linspace(a, b, n)
     h = tu[1] - tu[0]
     u = np.interp(tu, t, y)
     v = np.interp(tu, tr, yr)
-    u = u - np.mean(u)
-    v = v - np.mean(v)
-    if not (np.any(u != 0) and np.any(v != 0)):
+    if not np.any(v != v[0]):
+        return None  # a constant reference has no phase
+    if max_lag is None:
+        max_lag = 0.25 * (b - a)
+    ms = max(1, min(n // 2, int(math.ceil(max_lag / h))))
+    shifts = np.arange(-ms, ms + 1)
+    cost = np.empty(len(shifts))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for i, sft in enumerate(shifts):
+            d = u[sft:] - v[:n - sft] if sft >= 0 else u[:n + sft] - v[-sft:]
+            cost[i] = np.mean(d * d)
+    if not np.all(np.isfinite(cost)):
         return None
-    max_shift = n // 2 if max_lag is None else max(1, min(n // 2, int(round(max_lag / h))))
-    # c[s] = sum u[i] v[i - s]: the correlation when y is delayed by s samples.
-    full = np.correlate(u, v, mode="full")  # index n-1 = shift 0
-    mid = n - 1
-    lo, hi = mid - max_shift, mid + max_shift
-    seg = full[lo:hi + 1] / np.maximum(n - np.abs(np.arange(-max_shift, max_shift + 1)), 1)
-    k = int(np.argmax(seg))
-    shift = float(k - max_shift)
-    if 0 < k < len(seg) - 1:
-        den = seg[k - 1] - 2 * seg[k] + seg[k + 1]
-        if den != 0:
-            shift += 0.5 * (seg[k - 1] - seg[k + 1]) / den
+    k = int(np.argmin(cost))
+    shift = float(shifts[k])
+    if 0 < k < len(cost) - 1:
+        den = cost[k - 1] - 2 * cost[k] + cost[k + 1]
+        if den > 0:
+            shift += 0.5 * (cost[k - 1] - cost[k + 1]) / den
     return finite(shift * h)
 
 
@@ -228,12 +232,15 @@ def compare(t, y, tr, yr, window=None, steady_fraction=0.1):
             m["max_rel"] = m["max_abs"] / float(np.max(np.abs(r))) if np.max(np.abs(r)) > 0 else None
     s = signal_metrics(t, y, None, steady_fraction)
     sr = signal_metrics(tr, yr, None, steady_fraction)
+    scale = float(np.max(np.abs(yr)))
     for q in ("steady", "mean", "amplitude", "frequency"):
         m[q] = s[q]
         m[q + "_ref"] = sr[q]
         if s[q] is not None and sr[q] is not None:
             m[q + "_err"] = s[q] - sr[q]
-            m[q + "_rel"] = abs(s[q] - sr[q]) / abs(sr[q]) if sr[q] != 0 else None
+            # Relative only against a reference value that is not zero at the signal's scale.
+            small = 1e-9 * scale if q in ("steady", "mean", "amplitude") else 0.0
+            m[q + "_rel"] = abs(s[q] - sr[q]) / abs(sr[q]) if abs(sr[q]) > small else None
     max_lag = 0.5 / sr["frequency"] if sr["frequency"] else None
     m["phase_lag"] = phase_lag(t, y, tr, yr, max_lag) if b > a else None
     if m["phase_lag"] is not None and sr["frequency"]:
@@ -975,6 +982,9 @@ def write_tables(study, out, records, ref_rec):
             w.writerow(line)
     os.replace(tmp, out / "results.csv")
     counts = outcome_counts(records)
+    with open(out / "results.csv") as f:  # the promise: no NaN / inf cell, ever
+        counts["nan_cells"] = sum(c.strip().lower() in ("nan", "-nan", "inf", "-inf", "+inf", "infinity")
+                                  for row in csv.reader(f) for c in row)
     stab = stability_table(study, records)
     if stab:
         keys = list(stab[0].keys())
@@ -1061,7 +1071,9 @@ def cmd_run(args):
     study = Study(args.study)
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(study.path, out / "study.yaml")
+    copy = dict(study.raw)
+    copy["scene"] = str(study.scene)  # the copy works from DIR (plot, analyse)
+    (out / "study.yaml").write_text(f"# copy of {study.path}\n" + yaml.safe_dump(copy, sort_keys=False))
     fsi = args.fsi or os.environ.get("FSI_BIN") or str(REPO / "build" / "bin" / "fsi")
     if not os.access(fsi, os.X_OK):
         raise StudyError(f"fsi executable not found: {fsi} (build it, or pass --fsi)")
@@ -1216,7 +1228,7 @@ def plot_stability(plt, d, meta, cfg):
         if form:
             base = dict(meta.get("base_params") or {})
             base.update({k: v for k, v in zip(series, g)})
-            grid = np.unique(np.concatenate([[0.0], np.geomspace(linthresh / 10, max(xs_all + [1.0]) * 1.5, 300)]))
+            grid = np.unique(np.concatenate([np.linspace(0.0, linthresh, 50), np.geomspace(linthresh, max(xs_all + [1.0]) * 1.5, 300)]))
             vals = []
             for gx in grid:
                 p = dict(base)
