@@ -124,6 +124,11 @@ RunOutcome Coupler::run(RunReport& report) {
     force_nm1 = force_n;
 
     // 3. Time loop.
+    // Work done across the interface, on each side: by the load the solid was actually
+    // given, and by the fluid's traction on the fluid's interface motion. With the
+    // transpose mapping they differ only by the partitioned scheme's lag and relaxation.
+    double work_solid = 0, work_fluid = 0;
+    Eigen::VectorXd d_s_prev = d_s, d_f_prev = map_.to_fluid(d_s);
     ProbeTable probes(out_dir_ / "probes.csv");
     CsvWriter iterations(out_dir_ / "iterations.csv",
                          {"step", "time", "iteration", "residual", "force_norm", "solid_newton", "fluid_iterations"});
@@ -135,6 +140,9 @@ RunOutcome Coupler::run(RunReport& report) {
       double first_residual = 0, residual = 0;
       bool converged = settings_.tolerance == 0;
       int k = 1;
+      SolidStepResult s_last;
+      FluidLoads loads_last;
+      Eigen::VectorXd force_applied, d_f_last;
       for (; k <= settings_.max_iterations; ++k) {
         if (interrupt_flag()) throw Stop{"failed", fmt::format("interrupted at step {} iteration {}", n, k)};
         const StepInfo info{t_np1, time.dt, n, k};
@@ -170,6 +178,10 @@ RunOutcome Coupler::run(RunReport& report) {
         residual = (relaxed - force).norm() / std::max(norm, settings_.residual_floor);
         iterations.row(std::vector<double>{double(n), t_np1, double(k), residual, norm, double(s.newton_iterations),
                                            double(loads.nonlinear_iterations)});
+        force_applied = force;
+        s_last = s;
+        loads_last = loads;
+        d_f_last = d_f;
         force = relaxed;
         ++out.iterations;
         if (norm > settings_.force_limit)
@@ -204,8 +216,17 @@ RunOutcome Coupler::run(RunReport& report) {
         Timer t(fluid_time);
         for (const auto& [name, v] : fluid_.accept_step(accepted)) row["fluid." + name] = v;
       }
+      {
+        Timer t(coupler_time);
+        work_solid += force_applied.dot(s_last.interface_displacement - d_s_prev);
+        work_fluid -= loads_last.traction_force.dot(d_f_last - d_f_prev);
+        d_s_prev = s_last.interface_displacement;
+        d_f_prev = d_f_last;
+      }
       row["coupling.iterations"] = used;
       row["coupling.residual"] = residual;
+      row["coupling.work_solid"] = work_solid;
+      row["coupling.work_fluid"] = work_fluid;
       for (const auto& [name, v] : row)
         if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
       probes.add(t_np1, row);

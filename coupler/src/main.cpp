@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
     if (solid) w["solid_compute"] = solid->times().compute, w["solid_messaging"] = solid->times().messaging();
     if (fluid) w["fluid_compute"] = fluid->times().compute, w["fluid_messaging"] = fluid->times().messaging();
     if (coupler) w["coupler_mapping_relaxation"] = coupler->times().coupler;
+    if (solid && !solid->timings().empty()) w["solid_breakdown"] = solid->timings();
+    if (fluid && !fluid->timings().empty()) w["fluid_breakdown"] = fluid->timings();
     report.data()["steps"] = outcome.steps;
     report.data()["coupling_iterations"] = outcome.iterations;
   };

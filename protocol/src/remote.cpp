@@ -161,6 +161,7 @@ std::map<std::string, double> RemoteSolid::accept_step(const StepInfo& info) {
   r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
   const auto reply = client_->call(r);
   expect(reply.has_accept(), *client_, "accept_step");
+  timings_ = {reply.accept().timings().begin(), reply.accept().timings().end()};
   return {reply.accept().probes().begin(), reply.accept().probes().end()};
 }
 
@@ -233,6 +234,7 @@ std::map<std::string, double> RemoteFluid::accept_step(const StepInfo& info) {
   r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
   const auto reply = client_->call(r);
   expect(reply.has_accept(), *client_, "accept_step");
+  timings_ = {reply.accept().timings().begin(), reply.accept().timings().end()};
   return {reply.accept().probes().begin(), reply.accept().probes().end()};
 }
 

@@ -159,7 +159,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       need_model("accept_step");
       StepInfo info{request.accept_step().time(), dt_, static_cast<int>(request.accept_step().step()), 0};
       for (const auto& [k, v] : model_->accept_step(info)) (*reply.mutable_accept()->mutable_probes())[k] = v;
-      reply.mutable_accept();
+      for (const auto& [k, v] : model_->timings()) (*reply.mutable_accept()->mutable_timings())[k] = v;
       break;
     }
     case R::kWriteOutput: {
@@ -249,6 +249,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       StepInfo info{request.accept_step().time(), 0, static_cast<int>(request.accept_step().step()), 0};
       reply.mutable_accept();
       for (const auto& [k, v] : model_->accept_step(info)) (*reply.mutable_accept()->mutable_probes())[k] = v;
+      for (const auto& [k, v] : model_->timings()) (*reply.mutable_accept()->mutable_timings())[k] = v;
       break;
     }
     case R::kWriteOutput: {

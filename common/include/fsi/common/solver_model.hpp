@@ -71,6 +71,9 @@ class SolidModel {
   // Makes the last solve the new accepted state; returns named probes.
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
+  // Cumulative wall seconds by category (e.g. "assembly", "linear_solve"), reported in
+  // the run summary. Optional.
+  virtual std::map<std::string, double> timings() const { return {}; }
 };
 
 struct FluidSetup {
@@ -102,6 +105,8 @@ class FluidModel {
                                 const Eigen::VectorXd& interface_velocity) = 0;
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
+  // Cumulative wall seconds by category (e.g. "mesh_motion", "assembly", "linear_solve").
+  virtual std::map<std::string, double> timings() const { return {}; }
 };
 
 }  // namespace fsi

@@ -24,11 +24,13 @@ class RemoteSolid : public SolidModel {
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
+  std::map<std::string, double> timings() const override { return timings_; }
   void stop(const std::string& reason);
   RemoteTimes times() const { return {client_->wall_seconds(), client_->server_compute_seconds()}; }
   ProtocolClient& client() { return *client_; }
 
  private:
+  std::map<std::string, double> timings_;
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "solid server";
   bool supports_damping_ = false;
@@ -45,11 +47,13 @@ class RemoteFluid : public FluidModel {
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
+  std::map<std::string, double> timings() const override { return timings_; }
   void stop(const std::string& reason);
   RemoteTimes times() const { return {client_->wall_seconds(), client_->server_compute_seconds()}; }
   ProtocolClient& client() { return *client_; }
 
  private:
+  std::map<std::string, double> timings_;
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "fluid server";
   InterfaceMeshData interface_;
