@@ -75,11 +75,12 @@ def fmt_num(x):
 
 def clean_value(v):
     """Stable representation of a parameter value (floats rounded to 12 significant digits)."""
+    if isinstance(v, str) and re.fullmatch(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?", v.strip()):
+        v = float(v)  # YAML 1.1 reads 1.0e9 (no exponent sign) as a string
     if isinstance(v, bool) or isinstance(v, int) or isinstance(v, str):
         return v
     if isinstance(v, (float, np.floating)):
-        f = float("%.12g" % float(v))
-        return int(f) if False else f
+        return float("%.12g" % float(v))
     if isinstance(v, np.integer):
         return int(v)
     return v
@@ -557,6 +558,10 @@ def classify(summary, exit_code, marker_state, log_tail=""):
     """outcome (completed / diverged / mesh tangled / solver failed / failed / timeout / crashed),
     reason kind, reason, step and iteration of a stop."""
     r = {"status": "", "outcome": "", "reason_kind": "", "reason": "", "stop_step": None, "stop_iteration": None}
+    if marker_state == "interrupted":
+        r.update(status=(summary or {}).get("status", ""), outcome="interrupted", reason_kind="study interrupted",
+                 reason="stopped by Ctrl-C / SIGTERM of the study; run again to resume")
+        return r
     if marker_state == "timeout":
         r.update(status=(summary or {}).get("status", ""), outcome="timeout", reason_kind="time limit")
         r["reason"] = "killed after the study's time limit"
@@ -942,6 +947,8 @@ def outcome_counts(records):
             c["failed_by_reason"][k] = c["failed_by_reason"].get(k, 0) + 1
         elif o == "timeout":
             c["timeouts"] += 1
+        elif o == "interrupted":
+            c["interrupted"] = c.get("interrupted", 0) + 1
         else:
             c["crashes"] += 1
     return c
