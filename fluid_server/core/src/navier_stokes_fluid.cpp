@@ -233,8 +233,15 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     for (const auto& g : interface_groups)
       if (!fluid_mesh.has_boundary(g)) section.child("interface").fail("groups", "no boundary group '" + g + "'");
     solver.set_interface(interface_groups);
+    const auto iface = section.child("interface");
+    MeshMotionOptions motion;
+    motion.stiffening = iface.get<double>("mesh_stiffening", 1.0);
+    const auto method = iface.get<std::string>("mesh_motion", "harmonic");
+    if (method == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
+    else if (method != "harmonic") iface.fail("mesh_motion", "must be 'harmonic' or 'elastic'");
+    motion.incremental = iface.get<bool>("mesh_incremental", false);
     motion_ = std::make_unique<MeshMotion>(fluid_mesh, solver.interface_nodes(), fluid_mesh.boundary_nodes(fixed_groups),
-                                           section.child("interface").get<double>("mesh_stiffening", 1.0));
+                                           motion);
   }
 
   // --- probes and output ---
@@ -293,7 +300,10 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
                                          const Eigen::VectorXd& interface_velocity) {
   const auto t0 = std::chrono::steady_clock::now();
   Eigen::MatrixX2d positions = solver_->mesh().nodes;
-  if (motion_ && interface_displacement.size() > 0) positions += motion_->extend(interface_displacement);
+  if (motion_ && interface_displacement.size() > 0) {
+    positions += motion_->extend(interface_displacement);
+    last_interface_displacement_ = interface_displacement;
+  }
   try {
     last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
   } catch (const SolverError& e) {
@@ -317,6 +327,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
 
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
   solver_->accept();
+  if (motion_ && last_interface_displacement_.size() > 0) motion_->accept(last_interface_displacement_);
   std::map<std::string, double> probes;
   for (const auto& f : forces_) {
     const Eigen::Vector2d force = solver_->force(f.groups);

@@ -44,6 +44,11 @@ class NavierStokesFluid : public FluidModel {
   NavierStokesSolver& solver() { return *solver_; }
   const StepReport& last_report() const { return last_report_; }
 
+  // Cumulative seconds: "mesh_motion" (extension), "step" (mesh motion + assembly + solves).
+  std::map<std::string, double> timings() const override {
+    return {{"mesh_motion", motion_ ? motion_->seconds() : 0.0}, {"step", solve_seconds_}};
+  }
+
  private:
   struct ForceProbe {
     std::string name;
@@ -63,6 +68,7 @@ class NavierStokesFluid : public FluidModel {
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
   int factorisations_ = 0;  // cumulative
+  Eigen::VectorXd last_interface_displacement_;  // of the last solve (for the mesh motion's accept)
 };
 
 }  // namespace fsi::fluid
