@@ -190,15 +190,33 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
       lo = lo.cwiseMin(fluid_mesh.nodes.row(i).transpose());
       hi = hi.cwiseMax(fluid_mesh.nodes.row(i).transpose());
     }
+    // The profile may span more than the group (a half channel with a symmetry line):
+    // profile_extent: [[x0, y0], [x1, y1]] are the ends of the full profile.
+    if (inflow.has("profile_extent")) {
+      const auto ends = inflow.get<std::vector<std::vector<double>>>("profile_extent");
+      if (ends.size() != 2 || ends[0].size() != 2 || ends[1].size() != 2)
+        inflow.fail("profile_extent", "must be [[x0, y0], [x1, y1]]");
+      lo = Eigen::Vector2d(ends[0][0], ends[0][1]);
+      hi = Eigen::Vector2d(ends[1][0], ends[1][1]);
+      if ((hi - lo).norm() <= 0) inflow.fail("profile_extent", "has zero length");
+    }
     const Eigen::Vector2d tangent = (hi - lo).normalized();
     const double width = (hi - lo).norm();
+    // pulsation: {mean, amplitude, frequency} multiplies the profile by mean + amplitude sin(2 pi f t).
+    double pulse_mean = 1.0, pulse_amplitude = 0.0, pulse_frequency = 0.0;
+    if (auto pulse = inflow.optional_child("pulsation")) {
+      pulse_mean = pulse->get<double>("mean", 1.0);
+      pulse_amplitude = pulse->get<double>("amplitude");
+      pulse_frequency = pulse->get<double>("frequency");
+    }
     std::function<double(double)> shape;
     if (profile == "parabolic") shape = [](double s) { return 4 * s * (1 - s); };
     else if (profile == "uniform") shape = [](double) { return 1.0; };
     else inflow.fail("profile", "must be parabolic or uniform, got '" + profile + "'");
     solver.add_dirichlet(group, [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
       const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
-      const double factor = (ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0;
+      const double factor = ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
+                            (pulse_mean + pulse_amplitude * std::sin(2 * M_PI * pulse_frequency * t));
       return umax * factor * shape(s) * direction;
     });
   }
