@@ -59,6 +59,22 @@ def main():
         print(f"{c:>6}: mean {s['mean']:.6g}  amplitude {s['amplitude']:.6g}  max {s['max']:.6g}  "
               f"min {s['min']:.6g}  frequency {s['frequency']:.5g} Hz ({s['periods']} periods)"
               + (f"  St {s['strouhal']:.5f}" if a.strouhal_scale else ""))
+    if "cl" in a.columns and "dp" in a.columns and result["cl"]["frequency"] == result["cl"]["frequency"]:
+        # DFG 2D-2: dp at t0 + 1/(2f), t0 = time of the last complete C_L maximum.
+        pts = [(ti, float(r["cl"]), float(r["dp"])) for ti, r in zip(t, rows)]
+        half = 0.5 / result["cl"]["frequency"]
+        peaks = [i for i in range(1, len(pts) - 1)
+                 if pts[i][1] >= pts[i - 1][1] and pts[i][1] > pts[i + 1][1] and pts[i][0] + half <= t_end]
+        if peaks:
+            t0 = pts[peaks[-1]][0]
+            target = t0 + half
+            for i in range(1, len(pts)):
+                if pts[i][0] >= target:
+                    s_ = (target - pts[i - 1][0]) / (pts[i][0] - pts[i - 1][0])
+                    dp_half = pts[i - 1][2] + s_ * (pts[i][2] - pts[i - 1][2])
+                    result["dp_half_period"] = {"t0": t0, "value": dp_half}
+                    print(f"    dp(t0 + 1/(2f)) = {dp_half:.5f} (t0 = {t0:.4f}, time of the last C_L maximum)")
+                    break
     if a.json:
         json.dump(result, open(a.json, "w"), indent=2)
     return 0
