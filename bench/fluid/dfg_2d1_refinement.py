@@ -4,7 +4,8 @@
 Usage (from the repository root, after building fluid_run):
   python3 bench/fluid/dfg_2d1_refinement.py --runner build-fluid/bin/fluid_run --out out/dfg_2d1_refinement
 
-Writes OUT/table.md, OUT/results.json and OUT/error_vs_wall_time.png.
+Writes OUT/table.md, OUT/results.json and OUT/error_vs_wall_time.png (the plot needs
+matplotlib: the system /usr/bin/python3 has it; re-plot with --plot-only).
 """
 import argparse
 import json
@@ -23,8 +24,11 @@ def main():
     ap.add_argument("--scene", default="configs/dfg_2d1.yaml")
     ap.add_argument("--out", default="out/dfg_2d1_refinement")
     ap.add_argument("--levels", type=int, default=len(LEVELS))
+    ap.add_argument("--plot-only", action="store_true", help="re-plot OUT/results.json")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
+    if a.plot_only:
+        return plot(json.load(open(os.path.join(a.out, "results.json"))), a.out)
     results = []
     for h, hc in LEVELS[: a.levels]:
         run_dir = os.path.join(a.out, f"h{h:g}")
@@ -55,6 +59,10 @@ def main():
             f.write(f"| {r['h']:g} | {r['hc']:g} | {r['dofs']} | {r['cd']:.5f} | {r['cd_error_percent']:+.3f}% | "
                     f"{r['cl']:.6f} | {r['cl_error_percent']:+.2f}% | {r['dp']:.5f} | {r['dp_error_percent']:+.3f}% | "
                     f"{r['solves']} | {r['factorisations']:g} | {r['wall_seconds']:.1f} |\n")
+    return plot(results, a.out)
+
+
+def plot(results, out):
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -71,7 +79,7 @@ def main():
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
         fig.tight_layout()
-        fig.savefig(os.path.join(a.out, "error_vs_wall_time.png"), dpi=120)
+        fig.savefig(os.path.join(out, "error_vs_wall_time.png"), dpi=120)
     except ImportError:
         print("matplotlib missing: no plot")
     return 0

@@ -143,6 +143,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
     params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
     params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
+    params.krylov_refactor_iterations = ls->get<int>("krylov_refactor_iterations", params.krylov_refactor_iterations);
   }
 
   // Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's

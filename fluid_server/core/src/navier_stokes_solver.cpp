@@ -70,6 +70,7 @@ struct NavierStokesSolver::Impl {
   LuSolver lu;
   bool analysed = false;
   bool factorised = false;
+  bool stale = false;  // the factors precondition poorly: refactorise at the next solve
   std::vector<DirichletCondition> dirichlet;
   std::vector<SymmetryCondition> symmetry;
   std::vector<InterfaceSegment> segments;
@@ -396,7 +397,7 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
 
     Eigen::VectorXd U_new;
     bool solved = false;
-    if (params_.reuse_factorisation && impl_->factorised) {
+    if (params_.reuse_factorisation && impl_->factorised && !impl_->stale) {
       const auto t_solve = Clock::now();
       Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, FrozenLuPreconditioner> krylov;
       krylov.preconditioner().set(&impl_->lu);
@@ -408,6 +409,7 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
       if (krylov.info() == Eigen::Success && U_new.allFinite()) {
         solved = true;
         report.krylov_iterations += static_cast<int>(krylov.iterations());
+        if (krylov.iterations() > params_.krylov_refactor_iterations) impl_->stale = true;
       }
     }
     if (!solved) {
@@ -423,6 +425,7 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
                                       "matrix?: check that the pressure is fixed by an outlet or a pressure reference)",
                                       time, iteration));
       impl_->factorised = true;
+      impl_->stale = false;
       ++report.factorisations;
       report.factor_seconds += seconds_since(t_factor);
       const auto t_solve = Clock::now();

@@ -39,13 +39,14 @@ struct FlowParameters {
   StabilisationParameters stabilisation;
   double nitsche_penalty = 0;    // gamma_N1
   double nitsche_symmetry = -1;  // gamma_N2 (+1 symmetric, -1 unsymmetric)
-  int threads = 2;
+  int threads = 1;
   int umfpack_irstep = 0;
   // Reuse the last LU factors as the preconditioner of BiCGSTAB on the new matrix; refactorise
   // only when BiCGSTAB needs more than krylov_max_iterations (or on the first solve).
   bool reuse_factorisation = true;
   double krylov_tolerance = 1e-10;  // relative residual
   int krylov_max_iterations = 25;
+  int krylov_refactor_iterations = 8;  // a solve needing more marks the factors stale: refactorise next time
 };
 
 struct StepReport {
