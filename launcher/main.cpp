@@ -51,6 +51,10 @@ Child spawn(const std::string& name, const std::vector<std::string>& argv, const
   if (pid < 0) throw std::runtime_error("fork failed for " + name);
   if (pid == 0) {
     prctl(PR_SET_PDEATHSIG, SIGTERM);  // never outlive the launcher
+    // Two or three solver processes share the cores: no busy-waiting OpenMP threads and
+    // one BLAS thread each, unless the user says otherwise (TOOLCHAIN.md, docs/fluid.md).
+    setenv("OMP_WAIT_POLICY", "passive", 0);
+    setenv("OPENBLAS_NUM_THREADS", "1", 0);
     setpgid(0, 0);                     // own process group: Ctrl-C goes through the launcher
     if (!log.empty()) {
       FILE* f = std::fopen(log.c_str(), "w");

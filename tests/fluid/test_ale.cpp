@@ -67,8 +67,12 @@ TEST(MeshMotion, HarmonicExtensionFollowsTheInterfaceAndKeepsBoundariesFixed) {
   const auto u = motion.extend(d);
   for (int i = 0; i < mesh.node_count(); ++i) {
     const double y = mesh.nodes(i, 1);
-    if (y > 1 - 1e-12) EXPECT_EQ(u(i, 1), 0.0);
-    if (y < 1e-12) EXPECT_DOUBLE_EQ(u(i, 1), 0.1);
+    if (y > 1 - 1e-12) {
+      EXPECT_EQ(u(i, 1), 0.0);
+    }
+    if (y < 1e-12) {
+      EXPECT_DOUBLE_EQ(u(i, 1), 0.1);
+    }
     EXPECT_GE(u(i, 1), -1e-12);
     EXPECT_LE(u(i, 1), 0.1 + 1e-12);  // maximum principle
   }
