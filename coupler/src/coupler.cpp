@@ -137,7 +137,7 @@ RunOutcome Coupler::run(RunReport& report) {
       const double t_np1 = n * time.dt;
       Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * force_n - force_nm1)
                                                                                : force_n;
-      double first_residual = 0, residual = 0;
+      double first_residual = 0, residual = 0, first_change = 0;
       bool converged = settings_.tolerance == 0;
       int k = 1;
       SolidStepResult s_last;
@@ -175,7 +175,8 @@ RunOutcome Coupler::run(RunReport& report) {
         if (!all_finite(relaxed))
           throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
         const double norm = relaxed.norm();
-        residual = (relaxed - force).norm() / std::max(norm, settings_.residual_floor);
+        const double change = (relaxed - force).norm();
+        residual = change / std::max(norm, settings_.residual_floor);
         iterations.row(std::vector<double>{double(n), t_np1, double(k), residual, norm, double(s.newton_iterations),
                                            double(loads.nonlinear_iterations)});
         force_applied = force;
@@ -188,16 +189,20 @@ RunOutcome Coupler::run(RunReport& report) {
           throw Stop{"diverged", fmt::format("interface force norm {:.3e} exceeds force_limit {:.3e} at step {} "
                                              "iteration {} (loosely coupled instability?)",
                                              norm, settings_.force_limit, n, k)};
-        if (k == 1) first_residual = residual;
+        if (k == 1) first_residual = residual, first_change = change;
         if (settings_.tolerance > 0) {
           if (residual < settings_.tolerance) {
             converged = true;
             break;
           }
-          if (k > 1 && residual > settings_.divergence_factor * std::max(first_residual, settings_.residual_floor))
-            throw Stop{"diverged", fmt::format("coupling residual grew from {:.3e} to {:.3e} at step {} iteration {} "
+          // Geometric growth keeps the relative residual constant: watch the absolute change.
+          if (k > 1 && (residual > settings_.divergence_factor * std::max(first_residual, settings_.residual_floor) ||
+                        change > settings_.divergence_factor * std::max(first_change, settings_.residual_floor)))
+            throw Stop{"diverged", fmt::format("coupling residual grew: |F^(k+1) - F^(k)| from {:.3e} to {:.3e} "
+                                               "(relative {:.3e} to {:.3e}) at step {} iteration {} "
                                                "(relaxation {} above the stability limit?)",
-                                               first_residual, residual, n, k, settings_.relaxation)};
+                                               first_change, change, first_residual, residual, n, k,
+                                               settings_.relaxation)};
         }
       }
       const int used = std::min(k, settings_.max_iterations);
