@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -140,6 +141,8 @@ RunOutcome Coupler::run(RunReport& report) {
       double first_residual = 0, residual = 0, first_change = 0;
       bool converged = settings_.tolerance == 0;
       int k = 1;
+      Eigen::VectorXd previous_r;
+      double previous_omega = settings_.relaxation;
       SolidStepResult s_last;
       FluidLoads loads_last;
       Eigen::VectorXd force_applied, d_f_last;
@@ -170,7 +173,19 @@ RunOutcome Coupler::run(RunReport& report) {
           const Eigen::VectorXd f_star = robin_force(map_.to_solid(loads.traction_force),
                                                      map_.to_solid(loads.velocity_integral), s.interface_velocity,
                                                      s.interface_displacement);
-          relaxed = -settings_.relaxation * f_star + (1.0 - settings_.relaxation) * force;
+          // F^(k+1) = F^(k) + omega_k r_k with r_k = -F* - F^(k): omega = beta is the paper's
+          // relaxation; Aitken updates omega from the last two residuals.
+          const Eigen::VectorXd r = -f_star - force;
+          double omega = settings_.relaxation;
+          if (settings_.acceleration == Acceleration::Aitken && k > 1 && previous_r.size() == r.size()) {
+            const Eigen::VectorXd dr = r - previous_r;
+            const double dr2 = dr.squaredNorm();
+            if (dr2 > 0) omega = std::clamp(-previous_omega * previous_r.dot(dr) / dr2, -1.0, 1.0);
+            if (std::abs(omega) < 1e-6) omega = settings_.relaxation;
+          }
+          previous_r = r;
+          previous_omega = omega;
+          relaxed = force + omega * r;
         }
         if (!all_finite(relaxed))
           throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};

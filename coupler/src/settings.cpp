@@ -22,6 +22,10 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   if (predictor == "previous") c.predictor = Predictor::Previous;
   else if (predictor == "linear") c.predictor = Predictor::Linear;
   else s.fail("predictor", "must be 'previous' (the paper: F_n) or 'linear' (2 F_n - F_{n-1})");
+  const auto acceleration = s.get<std::string>("acceleration", "constant");
+  if (acceleration == "constant") c.acceleration = Acceleration::Constant;
+  else if (acceleration == "aitken") c.acceleration = Acceleration::Aitken;
+  else s.fail("acceleration", "must be 'constant' (the paper: beta) or 'aitken' (dynamic relaxation)");
   const auto it = s.child("iterations");
   c.max_iterations = it.get<int>("max");
   if (c.max_iterations < 1) it.fail("max", "must be >= 1");

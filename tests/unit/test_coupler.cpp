@@ -195,3 +195,34 @@ TEST(Outcome, OutOfRangeRelaxationIsRejected) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Aitken, ConvergesAboveTheConstantRelaxationLimitInAFewIterations) {
+  // beta = 0.5 is far above Algorithm 1's limit 0.1827 for this problem; Aitken's secant
+  // update finds the optimal relaxation of this linear interface problem in one iteration.
+  const std::vector<std::string> base{"coupling.algorithm=1", "coupling.relaxation=0.5",
+                                      "coupling.iterations.max=50", "coupling.iterations.tolerance=1e-12",
+                                      "time.end=0.2", "time.dt=0.01", "solid.mass=1", "solid.damping=0.5",
+                                      "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"};
+  auto constant = base;
+  constant.push_back("coupling.acceleration=constant");
+  EXPECT_EQ(run_scene(constant).outcome.status, "diverged");
+  auto aitken = base;
+  aitken.push_back("coupling.acceleration=aitken");
+  const auto run = run_scene(aitken);
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  for (double k : run.column("coupling.iterations")) EXPECT_LE(k, 4);
+  // ... and the converged result is the monolithic BDF1 solution (m + m_a) a + c v + k d = F.
+  double d = 0, v = 0;
+  const double M = 11, c = 0.5, kk = 4, dt = 0.01;
+  const auto dx = run.column("solid.d_x");
+  for (std::size_t n = 0; n < dx.size(); ++n) {
+    const double dn = (1 + M * (d / (dt * dt) + v / dt) + c * d / dt) / (M / (dt * dt) + c / dt + kk);
+    v = (dn - d) / dt;
+    d = dn;
+    ASSERT_NEAR(dx[n], d, 1e-10) << "step " << n + 1;
+  }
+}
+
+}  // namespace

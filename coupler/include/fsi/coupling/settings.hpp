@@ -10,6 +10,9 @@ namespace fsi::coupling {
 
 enum class Algorithm { ExplicitSolidVelocity = 1, ImplicitSolidVelocity = 2 };
 enum class Predictor { Previous, Linear };
+// How F^(k+1) follows from F^(k) and F*: the paper's constant relaxation, or Aitken's
+// dynamic relaxation (beyond the paper; Kuttler & Wall 2008), which starts each step at beta.
+enum class Acceleration { Constant, Aitken };
 
 struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
@@ -17,6 +20,7 @@ struct CouplingSettings {
   double nitsche_symmetry = -1;   // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
   double relaxation = 1;          // beta in (0, 1]
   Predictor predictor = Predictor::Previous;  // F^(1)_{n+1} = F_n (the paper)
+  Acceleration acceleration = Acceleration::Constant;
   int max_iterations = 1;         // k_max
   // 0: exactly max_iterations iterations per step (the paper). > 0: iterate until the
   // relative interface residual ||F^(k+1) - F^(k)|| / ||F^(k+1)|| is below it.
