@@ -1,5 +1,6 @@
 #include "fsi/common/config.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -204,6 +205,22 @@ std::vector<std::string> ConfigSection::keys() const {
   if (node_.IsMap())
     for (const auto& kv : node_) out.push_back(kv.first.Scalar());
   return out;
+}
+
+std::array<double, 2> read_vector2(const ConfigSection& section, const std::string& key) {
+  if (!section.has(key)) {
+    section.get<double>(key, 0.0);  // marks the key as read
+    return {0.0, 0.0};
+  }
+  try {
+    return {section.get<double>(key), 0.0};
+  } catch (const ConfigError&) {
+    const auto v = section.get<std::vector<double>>(key);
+    if (v.size() != 2) section.fail(key, "must be a number or a list [x, y]");
+    for (double x : v)
+      if (!std::isfinite(x)) section.fail(key, "must be finite");
+    return {v[0], v[1]};
+  }
 }
 
 }  // namespace fsi

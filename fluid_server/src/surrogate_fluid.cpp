@@ -2,23 +2,14 @@
 
 namespace fsi::models {
 namespace {
-Eigen::Vector2d read_vector2(const ConfigSection& section, const std::string& key) {
-  if (!section.has(key)) {
-    section.get<double>(key, 0.0);
-    return Eigen::Vector2d::Zero();
-  }
-  try {
-    return Eigen::Vector2d(section.get<double>(key), 0.0);
-  } catch (const ConfigError&) {
-    const auto v = section.get<std::vector<double>>(key);
-    if (v.size() != 2) section.fail(key, "must be a number or a list [x, y]");
-    return Eigen::Vector2d(v[0], v[1]);
-  }
+Eigen::Vector2d vector2(const ConfigSection& section, const std::string& key) {
+  const auto v = fsi::read_vector2(section, key);
+  return {v[0], v[1]};
 }
 }  // namespace
 
 void SurrogateFluid::configure(const ConfigSection& s, const FluidSetup&) {
-  force_ = read_vector2(s, "force");
+  force_ = vector2(s, "force");
   added_mass_ = s.get<double>("added_mass", 0.0);
   measure_ = s.get<double>("interface_measure", 1.0);
   if (added_mass_ < 0) s.fail("added_mass", "must be >= 0");

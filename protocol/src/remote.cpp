@@ -118,6 +118,34 @@ Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, std::s
   return v;
 }
 
+// Calls both remote models make the same way.
+std::map<std::string, double> accept_call(ProtocolClient& client, const StepInfo& info,
+                                          std::map<std::string, double>& timings) {
+  fsi::v1::Request r;
+  r.mutable_accept_step()->set_time(info.time);
+  r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
+  const auto reply = client.call(r);
+  expect(reply.has_accept(), client, "accept_step");
+  timings = {reply.accept().timings().begin(), reply.accept().timings().end()};
+  return {reply.accept().probes().begin(), reply.accept().probes().end()};
+}
+
+std::vector<std::string> output_call(ProtocolClient& client, const StepInfo& info) {
+  fsi::v1::Request r;
+  r.mutable_write_output()->set_time(info.time);
+  r.mutable_write_output()->set_step(static_cast<unsigned>(info.step));
+  const auto reply = client.call(r);
+  expect(reply.has_output(), client, "write_output");
+  return {reply.output().files().begin(), reply.output().files().end()};
+}
+
+void stop_call(ProtocolClient& client, const std::string& reason) {
+  fsi::v1::Request r;
+  r.mutable_stop()->set_reason(reason);
+  client.set_timeout(std::chrono::seconds(2));
+  client.call(r);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------- solid
@@ -156,30 +184,12 @@ SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::Vecto
 }
 
 std::map<std::string, double> RemoteSolid::accept_step(const StepInfo& info) {
-  fsi::v1::Request r;
-  r.mutable_accept_step()->set_time(info.time);
-  r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
-  const auto reply = client_->call(r);
-  expect(reply.has_accept(), *client_, "accept_step");
-  timings_ = {reply.accept().timings().begin(), reply.accept().timings().end()};
-  return {reply.accept().probes().begin(), reply.accept().probes().end()};
+  return accept_call(*client_, info, timings_);
 }
 
-std::vector<std::string> RemoteSolid::write_output(const StepInfo& info) {
-  fsi::v1::Request r;
-  r.mutable_write_output()->set_time(info.time);
-  r.mutable_write_output()->set_step(static_cast<unsigned>(info.step));
-  const auto reply = client_->call(r);
-  expect(reply.has_output(), *client_, "write_output");
-  return {reply.output().files().begin(), reply.output().files().end()};
-}
+std::vector<std::string> RemoteSolid::write_output(const StepInfo& info) { return output_call(*client_, info); }
 
-void RemoteSolid::stop(const std::string& reason) {
-  fsi::v1::Request r;
-  r.mutable_stop()->set_reason(reason);
-  client_->set_timeout(std::chrono::seconds(2));
-  client_->call(r);
-}
+void RemoteSolid::stop(const std::string& reason) { stop_call(*client_, reason); }
 
 // ---------------------------------------------------------------------------- fluid
 RemoteFluid::RemoteFluid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
@@ -229,29 +239,11 @@ FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& 
 }
 
 std::map<std::string, double> RemoteFluid::accept_step(const StepInfo& info) {
-  fsi::v1::Request r;
-  r.mutable_accept_step()->set_time(info.time);
-  r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
-  const auto reply = client_->call(r);
-  expect(reply.has_accept(), *client_, "accept_step");
-  timings_ = {reply.accept().timings().begin(), reply.accept().timings().end()};
-  return {reply.accept().probes().begin(), reply.accept().probes().end()};
+  return accept_call(*client_, info, timings_);
 }
 
-std::vector<std::string> RemoteFluid::write_output(const StepInfo& info) {
-  fsi::v1::Request r;
-  r.mutable_write_output()->set_time(info.time);
-  r.mutable_write_output()->set_step(static_cast<unsigned>(info.step));
-  const auto reply = client_->call(r);
-  expect(reply.has_output(), *client_, "write_output");
-  return {reply.output().files().begin(), reply.output().files().end()};
-}
+std::vector<std::string> RemoteFluid::write_output(const StepInfo& info) { return output_call(*client_, info); }
 
-void RemoteFluid::stop(const std::string& reason) {
-  fsi::v1::Request r;
-  r.mutable_stop()->set_reason(reason);
-  client_->set_timeout(std::chrono::seconds(2));
-  client_->call(r);
-}
+void RemoteFluid::stop(const std::string& reason) { stop_call(*client_, reason); }
 
 }  // namespace fsi::protocol

@@ -1,31 +1,22 @@
 #include "fsi/models/sdof_solid.hpp"
 
 namespace fsi::models {
-
-Eigen::Vector2d read_vector2(const ConfigSection& section, const std::string& key) {
-  if (!section.has(key)) {
-    section.get<double>(key, 0.0);  // marks the key as read
-    return Eigen::Vector2d::Zero();
-  }
-  try {
-    return Eigen::Vector2d(section.get<double>(key), 0.0);
-  } catch (const ConfigError&) {
-    const auto v = section.get<std::vector<double>>(key);
-    if (v.size() != 2) section.fail(key, "must be a number or a list [x, y]");
-    for (double x : v)
-      if (!std::isfinite(x)) section.fail(key, "must be finite");
-    return Eigen::Vector2d(v[0], v[1]);
-  }
+namespace {
+Eigen::Vector2d vector2(const ConfigSection& section, const std::string& key) {
+  const auto v = fsi::read_vector2(section, key);
+  return {v[0], v[1]};
 }
+}  // namespace
+
 
 void SdofSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   mass_ = s.get<double>("mass");
   damping_ = s.get<double>("damping", 0.0);
   stiffness_ = s.get<double>("stiffness", 0.0);
   measure_ = s.get<double>("interface_measure", 1.0);
-  force_ = read_vector2(s, "force");
-  d0_ = read_vector2(s, "initial_displacement");
-  v0_ = read_vector2(s, "initial_velocity");
+  force_ = vector2(s, "force");
+  d0_ = vector2(s, "initial_displacement");
+  v0_ = vector2(s, "initial_velocity");
   if (!(mass_ > 0)) s.fail("mass", "must be positive");
   if (damping_ < 0) s.fail("damping", "must be >= 0");
   if (stiffness_ < 0) s.fail("stiffness", "must be >= 0");

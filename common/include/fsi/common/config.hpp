@@ -11,6 +11,7 @@
 //   scene.check_all_used("solid");                   // throws fsi::ConfigError on typos
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -95,6 +96,9 @@ class ConfigSection {
   YAML::Node node_;
   std::string path_;
 };
+
+// Reads a 2-vector given as a number (the x component, y = 0) or a list [x, y]; absent = 0.
+std::array<double, 2> read_vector2(const ConfigSection& section, const std::string& key);
 
 }  // namespace fsi
 

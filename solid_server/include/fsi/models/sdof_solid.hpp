@@ -29,7 +29,4 @@ class SdofSolid : public SolidModel {
   Eigen::Vector2d d0_ = Eigen::Vector2d::Zero(), v0_ = Eigen::Vector2d::Zero();
 };
 
-// Reads a number (x component) or a [x, y] list.
-Eigen::Vector2d read_vector2(const ConfigSection& section, const std::string& key);
-
 }  // namespace fsi::models
