@@ -73,6 +73,9 @@ RunOutcome Coupler::run(RunReport& report) {
           key != "fluid")
         throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
                                       "coupling, solid, fluid)", scene_.root().where(key), key));
+    if (settings_.predictor == Predictor::Linear)
+      log->warn("predictor 'linear' (2 F_n - F_(n-1)) can excite interface modes the iterations leave "
+                "unconverged (docs/fsi.md); 'previous' is the paper's and the robust choice");
     const double gamma = settings_.nitsche_penalty;
     const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
     if (implicit && gamma > 0 && !solid_.supports_interface_damping())
