@@ -122,7 +122,7 @@ def main():
         w = s.get("wall_time", {})
         result["wall_time"] = w
         tot = w.get("total", float("nan"))
-        parts = ", ".join(f"{k} {v:.1f} s ({100 * v / tot:.2f}%)" for k, v in w.items() if k != "total")
+        parts = ", ".join(f"{k} {v:.1f} s ({100 * v / tot:.2f}%)" for k, v in w.items() if k != "total" and not isinstance(v, dict))
         print(f"status {s.get('status')}; wall time {tot:.1f} s: {parts}")
     if a.json:
         json.dump(result, open(a.json, "w"), indent=2)
