@@ -106,9 +106,7 @@ int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const 
       model, scene, out_dir, "solid_server", "solid",
       [&](const TimeSettings& time) {
         const auto section = scene.section("solid");
-        const auto kind = section.get<std::string>("model");
-        model = factory(kind);
-        if (!model) section.fail("model", "names no solid model this server knows ('" + kind + "')");
+        model = make_model(factory, section, "solid");
         model->configure(section, SolidSetup{time.dt, time.end, 0.0, out_dir / "vtk"});
         scene.check_all_used();
       },
@@ -127,9 +125,7 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
       model, scene, out_dir, "fluid_server", "fluid",
       [&](const TimeSettings& time) {
         const auto section = scene.section("fluid");
-        const auto kind = section.get<std::string>("model");
-        model = factory(kind);
-        if (!model) section.fail("model", "names no fluid model this server knows ('" + kind + "')");
+        model = make_model(factory, section, "fluid");
         model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0, out_dir / "vtk"});
         scene.check_all_used();
       },

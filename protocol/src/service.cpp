@@ -47,6 +47,34 @@ Scene scene_from(const fsi::v1::Configure& c) {
   return Scene::parse(c.scene_text(), c.scene_path().empty() ? "<scene>" : c.scene_path(), overrides);
 }
 
+// The requests a solid and a fluid service answer the same way. Returns false for others.
+template <class Model>
+bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop, Model* model, double dt) {
+  using R = fsi::v1::Request;
+  const auto body = request.body_case();
+  if (body == R::kStop) {
+    reply.mutable_stop();
+    stop = true;
+    return true;
+  }
+  if (body != R::kGetInterface && body != R::kAcceptStep && body != R::kWriteOutput) return false;
+  if (!model)
+    throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, fmt::format("'{}' before 'configure'", body_name(request)));
+  if (body == R::kGetInterface) {
+    interface_to_proto(model->interface(), reply.mutable_interface());
+  } else if (body == R::kAcceptStep) {
+    const StepInfo info{request.accept_step().time(), dt, static_cast<int>(request.accept_step().step()), 0};
+    auto* out = reply.mutable_accept();
+    for (const auto& [k, v] : model->accept_step(info)) (*out->mutable_probes())[k] = v;
+    for (const auto& [k, v] : model->timings()) (*out->mutable_timings())[k] = v;
+  } else {
+    const StepInfo info{request.write_output().time(), dt, static_cast<int>(request.write_output().step()), 0};
+    auto* out = reply.mutable_output();
+    for (const auto& f : model->write_output(info)) out->add_files(f);
+  }
+  return true;
+}
+
 std::atomic<bool> g_signalled{false};
 extern "C" void on_signal(int) { g_signalled = true; }
 
@@ -102,6 +130,7 @@ SolidService::SolidService(SolidFactory factory, std::string server_name)
 
 void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
   using R = fsi::v1::Request;
+  if (handle_shared(request, reply, stop, model_.get(), dt_)) return;
   auto need_model = [&](const char* what) {
     if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE,
                                    fmt::format("'{}' before 'configure'", what));
@@ -122,12 +151,10 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
         throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
       const Scene scene = scene_from(c);
       const auto section = scene.section(c.section().empty() ? "solid" : c.section());
-      const auto kind = section.get<std::string>("model");
-      auto model = factory_(kind);
-      if (!model) section.fail("model", "names no solid model this server knows ('" + kind + "')");
+      auto model = make_model(factory_, section, "solid");
       if (c.interface_damping() > 0 && !model->supports_interface_damping())
         throw RemoteError(fsi::v1::Error::UNSUPPORTED,
-                          fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)", kind));
+                          fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)", model->name()));
       SolidSetup setup{c.dt(), c.end_time(), c.interface_damping(), c.output_dir()};
       model->configure(section, setup);
       scene.check_all_used(section.path());
@@ -137,10 +164,6 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
       break;
     }
-    case R::kGetInterface:
-      need_model("get_interface");
-      interface_to_proto(model_->interface(), reply.mutable_interface());
-      break;
     case R::kSolveStep: {
       need_model("solve_step");
       const auto& s = request.solve_step();
@@ -155,24 +178,6 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       out->set_newton_iterations(result.newton_iterations);
       break;
     }
-    case R::kAcceptStep: {
-      need_model("accept_step");
-      StepInfo info{request.accept_step().time(), dt_, static_cast<int>(request.accept_step().step()), 0};
-      for (const auto& [k, v] : model_->accept_step(info)) (*reply.mutable_accept()->mutable_probes())[k] = v;
-      for (const auto& [k, v] : model_->timings()) (*reply.mutable_accept()->mutable_timings())[k] = v;
-      break;
-    }
-    case R::kWriteOutput: {
-      need_model("write_output");
-      StepInfo info{request.write_output().time(), dt_, static_cast<int>(request.write_output().step()), 0};
-      auto* out = reply.mutable_output();
-      for (const auto& f : model_->write_output(info)) out->add_files(f);
-      break;
-    }
-    case R::kStop:
-      reply.mutable_stop();
-      stop = true;
-      break;
     default:
       throw RemoteError(fsi::v1::Error::UNSUPPORTED,
                         fmt::format("a solid server does not handle '{}'", body_name(request)));
@@ -185,6 +190,7 @@ FluidService::FluidService(FluidFactory factory, std::string server_name)
 
 void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
   using R = fsi::v1::Request;
+  if (handle_shared(request, reply, stop, model_.get(), 0.0)) return;
   auto need_model = [&](const char* what) {
     if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE,
                                    fmt::format("'{}' before 'configure'", what));
@@ -212,9 +218,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
         throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
       const Scene scene = scene_from(c);
       const auto section = scene.section(c.section().empty() ? "fluid" : c.section());
-      const auto kind = section.get<std::string>("model");
-      auto model = factory_(kind);
-      if (!model) section.fail("model", "names no fluid model this server knows ('" + kind + "')");
+      auto model = make_model(factory_, section, "fluid");
       FluidSetup setup{c.dt(), c.end_time(), c.nitsche_penalty(), c.nitsche_symmetry(), c.output_dir()};
       model->configure(section, setup);
       scene.check_all_used(section.path());
@@ -223,10 +227,6 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
       break;
     }
-    case R::kGetInterface:
-      need_model("get_interface");
-      interface_to_proto(model_->interface(), reply.mutable_interface());
-      break;
     case R::kInitialLoads: {
       need_model("initial_loads");
       const auto& s = request.initial_loads();
@@ -244,25 +244,6 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
           checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
       break;
     }
-    case R::kAcceptStep: {
-      need_model("accept_step");
-      StepInfo info{request.accept_step().time(), 0, static_cast<int>(request.accept_step().step()), 0};
-      reply.mutable_accept();
-      for (const auto& [k, v] : model_->accept_step(info)) (*reply.mutable_accept()->mutable_probes())[k] = v;
-      for (const auto& [k, v] : model_->timings()) (*reply.mutable_accept()->mutable_timings())[k] = v;
-      break;
-    }
-    case R::kWriteOutput: {
-      need_model("write_output");
-      StepInfo info{request.write_output().time(), 0, static_cast<int>(request.write_output().step()), 0};
-      auto* out = reply.mutable_output();
-      for (const auto& f : model_->write_output(info)) out->add_files(f);
-      break;
-    }
-    case R::kStop:
-      reply.mutable_stop();
-      stop = true;
-      break;
     default:
       throw RemoteError(fsi::v1::Error::UNSUPPORTED,
                         fmt::format("a fluid server does not handle '{}'", body_name(request)));

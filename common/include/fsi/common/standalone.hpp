@@ -14,6 +14,17 @@ namespace fsi {
 using SolidFactory = std::function<std::unique_ptr<SolidModel>(const std::string& model)>;
 using FluidFactory = std::function<std::unique_ptr<FluidModel>(const std::string& model)>;
 
+// Builds the model named by `section.model` ("solid" / "fluid" in messages); an unknown name
+// is a ConfigError naming the key and its line.
+template <class Model>
+std::unique_ptr<Model> make_model(const std::function<std::unique_ptr<Model>(const std::string&)>& factory,
+                                  const ConfigSection& section, const char* kind) {
+  const auto name = section.get<std::string>("model");
+  auto model = factory(name);
+  if (!model) section.fail("model", std::string("names no ") + kind + " model this server knows ('" + name + "')");
+  return model;
+}
+
 // Both build the model named by `<section>.model`, configure it (unknown keys anywhere in
 // the scene are an error), run every step with a zero interface load, and return the
 // process exit code (0 completed, 1 failed/diverged) after writing the summary.
