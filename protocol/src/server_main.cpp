@@ -1,0 +1,37 @@
+#include "fsi/protocol/server_main.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include "fsi/common/log.hpp"
+#include "fsi/common/process.hpp"
+
+namespace fsi::protocol {
+
+int server_main(int argc, char** argv, const ServerProgram& program) {
+  fsi::init_process();
+  const std::string name = program.kind + "_server";
+  // 1. Parse options.
+  CLI::App app{"FSI " + program.kind + " server"};
+  std::string bind = "tcp://127.0.0.1:5555", port_file, scene_path, out_dir = "out/" + program.kind;
+  std::vector<std::string> overrides;
+  double idle_timeout = 0;
+  app.add_option("--bind", bind, "endpoint to bind (tcp://HOST:PORT, port * = any free port)");
+  app.add_option("--port-file", port_file, "write the bound endpoint to this file");
+  app.add_option("--idle-timeout", idle_timeout, "exit after this many seconds without a request (0 = never)");
+  app.add_option("--standalone", scene_path, "run the scene's " + program.kind + " alone (no coupler)");
+  app.add_option("--out", out_dir, "output folder for --standalone");
+  app.add_option("--set", overrides, "override a scene key: dotted.key=value (with --standalone)");
+  CLI11_PARSE(app, argc, argv);
+
+  // 2. Run: standalone, or serve.
+  try {
+    if (!scene_path.empty()) return program.standalone(Scene::load(scene_path, overrides), out_dir);
+    const auto service = program.service();
+    return run_server(*service, bind, port_file, idle_timeout, name);
+  } catch (const std::exception& e) {
+    fsi::logger(name)->error("{}", e.what());
+    return 1;
+  }
+}
+
+}  // namespace fsi::protocol
