@@ -9,6 +9,7 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/table_writer.hpp"
+#include "fsi/coupling/acceleration.hpp"
 
 namespace fsi::coupling {
 namespace {
@@ -104,7 +105,8 @@ RunOutcome Coupler::run(RunReport& report) {
                          {"max_gap", map_.max_gap()}};
     data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
                         {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
-                        {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance}};
+                        {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
+                        {"acceleration", to_string(settings_.acceleration)}};
     log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
               to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
               settings_.tolerance, ns, fluid_interface.nodes());
@@ -137,6 +139,7 @@ RunOutcome Coupler::run(RunReport& report) {
     CsvWriter iterations(out_dir_ / "iterations.csv",
                          {"step", "time", "iteration", "residual", "force_norm", "solid_newton", "fluid_iterations"});
     Progress progress("coupler", time.steps);
+    InterfaceAccelerator accelerator(settings_);
     for (int n = 1; n <= time.steps; ++n) {
       const double t_np1 = n * time.dt;
       Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * force_n - force_nm1)
@@ -144,8 +147,7 @@ RunOutcome Coupler::run(RunReport& report) {
       double first_residual = 0, residual = 0, first_change = 0;
       bool converged = settings_.tolerance == 0;
       int k = 1;
-      Eigen::VectorXd previous_r;
-      double previous_omega = settings_.relaxation;
+      accelerator.begin_step();
       SolidStepResult s_last;
       FluidLoads loads_last;
       Eigen::VectorXd force_applied, d_f_last;
@@ -176,19 +178,9 @@ RunOutcome Coupler::run(RunReport& report) {
           const Eigen::VectorXd f_star = robin_force(map_.to_solid(loads.traction_force),
                                                      map_.to_solid(loads.velocity_integral), s.interface_velocity,
                                                      s.interface_displacement);
-          // F^(k+1) = F^(k) + omega_k r_k with r_k = -F* - F^(k): omega = beta is the paper's
-          // relaxation; Aitken updates omega from the last two residuals.
-          const Eigen::VectorXd r = -f_star - force;
-          double omega = settings_.relaxation;
-          if (settings_.acceleration == Acceleration::Aitken && k > 1 && previous_r.size() == r.size()) {
-            const Eigen::VectorXd dr = r - previous_r;
-            const double dr2 = dr.squaredNorm();
-            if (dr2 > 0) omega = std::clamp(-previous_omega * previous_r.dot(dr) / dr2, -1.0, 1.0);
-            if (std::abs(omega) < 1e-6) omega = settings_.relaxation;
-          }
-          previous_r = r;
-          previous_omega = omega;
-          relaxed = force + omega * r;
+          // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
+          // (acceleration.hpp for Aitken and IQN-ILS).
+          relaxed = accelerator.update(force, -f_star - force);
         }
         if (!all_finite(relaxed))
           throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
@@ -261,6 +253,7 @@ RunOutcome Coupler::run(RunReport& report) {
         solid_.write_output(accepted);
         fluid_.write_output(accepted);
       }
+      accelerator.end_step();
       force_nm1 = force_n;
       force_n = force;
       out.steps = n;

@@ -6,6 +6,10 @@ std::string to_string(Algorithm a) {
   return a == Algorithm::ExplicitSolidVelocity ? "1 (explicit solid velocity)" : "2 (implicit solid velocity, M_fs damping)";
 }
 
+std::string to_string(Acceleration a) {
+  return a == Acceleration::Constant ? "constant" : a == Acceleration::Aitken ? "aitken" : "iqn-ils";
+}
+
 CouplingSettings read_coupling(const ConfigSection& s) {
   CouplingSettings c;
   const int algorithm = s.get<int>("algorithm");
@@ -25,7 +29,18 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   const auto acceleration = s.get<std::string>("acceleration", "constant");
   if (acceleration == "constant") c.acceleration = Acceleration::Constant;
   else if (acceleration == "aitken") c.acceleration = Acceleration::Aitken;
-  else s.fail("acceleration", "must be 'constant' (the paper: beta) or 'aitken' (dynamic relaxation)");
+  else if (acceleration == "iqn-ils") c.acceleration = Acceleration::IqnIls;
+  else s.fail("acceleration", "must be 'constant' (the paper: beta), 'aitken' (dynamic relaxation) or 'iqn-ils' "
+              "(interface quasi-Newton)");
+  if (s.has("iqn")) {
+    const auto iqn = s.child("iqn");
+    if (c.acceleration != Acceleration::IqnIls)
+      s.fail("iqn", "is only read with 'acceleration: iqn-ils' (it is '" + acceleration + "')");
+    c.reuse_steps = iqn.get<int>("reuse_steps", 0);
+    if (c.reuse_steps < 0) iqn.fail("reuse_steps", "must be >= 0");
+    c.iqn_filter = iqn.get<double>("filter", 1e-3);
+    if (!(c.iqn_filter > 0 && c.iqn_filter < 1)) iqn.fail("filter", "must be in (0, 1)");
+  }
   const auto it = s.child("iterations");
   c.max_iterations = it.get<int>("max");
   if (c.max_iterations < 1) it.fail("max", "must be >= 1");

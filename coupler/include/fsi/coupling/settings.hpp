@@ -10,9 +10,10 @@ namespace fsi::coupling {
 
 enum class Algorithm { ExplicitSolidVelocity = 1, ImplicitSolidVelocity = 2 };
 enum class Predictor { Previous, Linear };
-// How F^(k+1) follows from F^(k) and F*: the paper's constant relaxation, or Aitken's
-// dynamic relaxation (beyond the paper; Kuttler & Wall 2008), which starts each step at beta.
-enum class Acceleration { Constant, Aitken };
+// How F^(k+1) follows from F^(k) and F*: the paper's constant relaxation, Aitken's dynamic
+// relaxation (Kuttler & Wall 2008) or interface quasi-Newton IQN-ILS (Degroote et al. 2009),
+// both beyond the paper and both starting each step with beta (acceleration.hpp).
+enum class Acceleration { Constant, Aitken, IqnIls };
 
 struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
@@ -21,6 +22,8 @@ struct CouplingSettings {
   double relaxation = 1;          // beta in (0, 1]
   Predictor predictor = Predictor::Previous;  // F^(1)_{n+1} = F_n (the paper)
   Acceleration acceleration = Acceleration::Constant;
+  int reuse_steps = 0;            // IQN-ILS: secant pairs of the last N accepted steps are reused
+  double iqn_filter = 1e-3;       // IQN-ILS: drop a column whose orthogonal remainder is below this share
   int max_iterations = 1;         // k_max
   // 0: exactly max_iterations iterations per step (the paper). > 0: iterate until the
   // relative interface residual ||F^(k+1) - F^(k)|| / ||F^(k+1)|| is below it.
@@ -35,5 +38,6 @@ struct CouplingSettings {
 CouplingSettings read_coupling(const ConfigSection& section);
 
 std::string to_string(Algorithm a);
+std::string to_string(Acceleration a);
 
 }  // namespace fsi::coupling
