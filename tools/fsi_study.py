@@ -42,7 +42,8 @@ FINISHED = ("completed", "diverged", "failed")
 ABBREV = {"coupling.algorithm": "alg", "coupling.gamma_n1": "g", "coupling.relaxation": "beta",
           "coupling.iterations.max": "kmax", "coupling.iterations.tolerance": "tol", "time.dt": "dt",
           "fluid.mesh.size": "h", "solid.mass": "m", "solid.stiffness": "k", "solid.damping": "c",
-          "fluid.added_mass": "ma", "coupling.predictor": "pred"}
+          "fluid.added_mass": "ma", "coupling.predictor": "pred",
+          "coupling.acceleration": "acc"}
 
 
 class StudyError(Exception):

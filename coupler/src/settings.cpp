@@ -36,7 +36,7 @@ CouplingSettings read_coupling(const ConfigSection& s) {
     const auto iqn = s.child("iqn");
     if (c.acceleration != Acceleration::IqnIls)
       s.fail("iqn", "is only read with 'acceleration: iqn-ils' (it is '" + acceleration + "')");
-    c.reuse_steps = iqn.get<int>("reuse_steps", 0);
+    c.reuse_steps = iqn.get<int>("reuse_steps", 8);
     if (c.reuse_steps < 0) iqn.fail("reuse_steps", "must be >= 0");
     c.iqn_filter = iqn.get<double>("filter", 1e-3);
     if (!(c.iqn_filter > 0 && c.iqn_filter < 1)) iqn.fail("filter", "must be in (0, 1)");

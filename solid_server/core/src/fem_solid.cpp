@@ -118,8 +118,9 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
     scheme_ = TimeScheme::Static;
   } else if (analysis == "dynamic") {
     if (scheme == "bdf1") scheme_ = TimeScheme::Bdf1;
+    else if (scheme == "bdf2") scheme_ = TimeScheme::Bdf2;
     else if (scheme == "newmark") scheme_ = TimeScheme::Newmark;
-    else s.fail("time_scheme", "must be 'bdf1' or 'newmark', got '" + scheme + "'");
+    else s.fail("time_scheme", "must be 'bdf1', 'bdf2' or 'newmark', got '" + scheme + "'");
   } else {
     s.fail("analysis", "must be 'static' or 'dynamic', got '" + analysis + "'");
   }
@@ -237,6 +238,8 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   d_n_ = v_n_ = a_n_ = f_n_ = Eigen::VectorXd::Zero(n);
   if (scheme_ == TimeScheme::Newmark) a_n_ = system_->solve_mass(dead_load_);
   d_ = d_n_, v_ = v_n_, a_ = a_n_, f_ = f_n_;
+  d_nm1_ = d_n_, v_nm1_ = v_n_;
+  accepted_steps_ = 0;
   solved_ = false;
   log->info("fem solid: {} nodes, {} Q4 cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
             mesh_.num_nodes(), mesh_.num_cells(), system_->num_free(), material->name(), constants.mu,
@@ -286,7 +289,18 @@ SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd
     }
     v_.setZero();
     a_.setZero();
-  } else if (scheme_ == TimeScheme::Bdf1) {
+  } else if (scheme_ == TimeScheme::Bdf2 && accepted_steps_ >= 1) {
+    // v = (3 d - 4 d_n + d_nm1) / (2 dt), a = (3 v - 4 v_n + v_nm1) / (2 dt)
+    TimeTerms t;
+    t.damping_coefficient = 1.5 / dt;
+    t.velocity_history = (-4.0 * d_n_ + d_nm1_) / (2.0 * dt);
+    t.mass_coefficient = 1.5 / dt * t.damping_coefficient;
+    t.acceleration_history = 1.5 / dt * t.velocity_history - (4.0 * v_n_ - v_nm1_) / (2.0 * dt);
+    d_ = d_n_ + dt * v_n_;
+    newton(d_, f_, t, info);
+    v_ = t.damping_coefficient * d_ + t.velocity_history;
+    a_ = t.mass_coefficient * d_ + t.acceleration_history;
+  } else if (scheme_ == TimeScheme::Bdf1 || scheme_ == TimeScheme::Bdf2) {
     TimeTerms t;
     t.mass_coefficient = 1.0 / (dt * dt);
     t.acceleration_history = -d_n_ / (dt * dt) - v_n_ / dt;
@@ -331,7 +345,9 @@ Eigen::Vector2d FemSolid::probe_displacement(const Probe& p, const Eigen::Vector
 
 std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
   if (!solved_) throw SolverError(fmt::format("solid: accept_step {} without a solve_step", info.step));
+  d_nm1_ = d_n_, v_nm1_ = v_n_;
   d_n_ = d_, v_n_ = v_, a_n_ = a_, f_n_ = f_;
+  ++accepted_steps_;
   solved_ = false;
   std::map<std::string, double> probes;
   for (const auto& p : probes_) {

@@ -22,7 +22,7 @@ struct CouplingSettings {
   double relaxation = 1;          // beta in (0, 1]
   Predictor predictor = Predictor::Previous;  // F^(1)_{n+1} = F_n (the paper)
   Acceleration acceleration = Acceleration::Constant;
-  int reuse_steps = 0;            // IQN-ILS: secant pairs of the last N accepted steps are reused
+  int reuse_steps = 8;            // IQN-ILS: secant pairs of the last N accepted steps are reused
   double iqn_filter = 1e-3;       // IQN-ILS: drop a column whose orthogonal remainder is below this share
   int max_iterations = 1;         // k_max
   // 0: exactly max_iterations iterations per step (the paper). > 0: iterate until the

@@ -11,7 +11,10 @@
 //   M_fs = gamma_N1 * int_interface N^T N dgamma  (reference configuration; only when the
 //   coupler sets SolidSetup::interface_damping > 0).
 // Schemes: `bdf1` (the paper: v = (d - d_n)/dt, a = (v - v_n)/dt), `newmark` (trapezoidal
-// rule, beta = 1/4, gamma = 1/2: second order, no numerical damping), and `static`
+// rule, beta = 1/4, gamma = 1/2: second order, no numerical damping), `bdf2` (v = (3 d -
+// 4 d_n + d_{n-1})/(2 dt), a from v alike; second order, slightly dissipative; its first step
+// is bdf1; the same difference formula as the fluid's BDF2 mesh velocity, so the interface
+// velocity the coupler hands to the fluid is the mesh velocity there), and `static`
 // analysis (equilibrium with the full load in `load_steps` increments per step).
 // The scene keys are documented in configs/csm1.yaml and docs/solid.md.
 #include <Eigen/Core>
@@ -25,7 +28,7 @@
 
 namespace fsi::solid {
 
-enum class TimeScheme { Static, Bdf1, Newmark };
+enum class TimeScheme { Static, Bdf1, Bdf2, Newmark };
 
 struct Probe {
   std::string name;
@@ -72,6 +75,8 @@ class FemSolid : public fsi::SolidModel {
   std::optional<PvdSeries> series_;
   // Accepted (n) and trial (n+1) states.
   Eigen::VectorXd d_n_, v_n_, a_n_, f_n_;
+  Eigen::VectorXd d_nm1_, v_nm1_;        // step n-1 (bdf2), valid once accepted_steps_ >= 1
+  int accepted_steps_ = 0;
   Eigen::VectorXd d_, v_, a_, f_;
   int last_iterations_ = 0;
   bool solved_ = false;
