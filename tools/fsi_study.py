@@ -893,7 +893,7 @@ def stability_table(study, records):
     series = list(st.get("series", []))
     groups = {}
     for r in records:
-        if r.get("is_reference"):
+        if r.get("is_reference") and not r.get("shared_reference"):
             continue
         g = tuple(r["params"].get(k) for k in series) + (r["params"].get(x),)
         others = tuple(sorted((k, v) for k, v in r["combo"].items() if k not in series and k not in (x, key)))
@@ -928,7 +928,7 @@ def outcome_counts(records):
     c = {"cases": 0, "completed": 0, "diverged": 0, "diverged_by_reason": {}, "mesh_tangled": 0,
          "solver_failed": 0, "failed": 0, "failed_by_reason": {}, "timeouts": 0, "crashes": 0, "nan_cells": 0}
     for r in records:
-        if r.get("is_reference"):
+        if r.get("is_reference") and not r.get("shared_reference"):
             continue
         c["cases"] += 1
         o = r["outcome"]
@@ -1044,11 +1044,18 @@ def build_sources(study):
 
 
 def reference_spec(study):
+    """The reference run's spec, or None. A reference run with exactly the overrides of one of
+    the sweep's runs *is* that run (it is run once, and plotted as the reference)."""
     ref = study.reference
     if "run" not in ref:
         return None
     combo = {k: clean_value(v) for k, v in flatten(ref["run"]).items()}
-    return study.spec(combo, name="reference")
+    spec = study.spec(combo, name="reference")
+    if not (study.stability or {}).get("bisection"):
+        for s in (study.spec(c) for c in study.combos()):
+            if s["sets"] == spec["sets"]:
+                return dict(s, shared=True)
+    return spec
 
 
 def analyse(study, out, runner_results, ref_spec):
@@ -1056,6 +1063,7 @@ def analyse(study, out, runner_results, ref_spec):
     ref_rec = runner_results.get(ref_spec["name"]) if ref_spec else None
     if ref_rec:
         ref_rec["is_reference"] = True
+        ref_rec["shared_reference"] = bool(ref_spec.get("shared"))
     ref_series = reference_series(study, out, ref_spec) if ref_rec and ref_rec["outcome"] == "completed" else None
     for r in records:
         r["metrics"] = run_metrics(study, out, r, ref_series)
@@ -1089,7 +1097,7 @@ def cmd_run(args):
     runner = Runner(study, out, os.path.abspath(fsi), jobs, quiet=args.quiet)
     sources, n = build_sources(study)
     ref = reference_spec(study)
-    if ref:
+    if ref and not ref.get("shared"):
         sources.insert(0, GridSource([ref]))
         n += 1
     runner.total_hint = n if not (study.stability or {}).get("bisection") else 0
@@ -1124,7 +1132,7 @@ def cmd_analyse(args):
     runner = Runner(study, out, "", 1, quiet=True)
     sources, _ = build_sources(study)
     ref = reference_spec(study)
-    specs = ([ref] if ref else [])
+    specs = ([ref] if ref and not ref.get("shared") else [])
     for src in sources:  # grids: every spec; bisection: replay from the markers
         while not src.finished():
             s = src.next()
@@ -1154,6 +1162,11 @@ def load_results(d):
     return rows, meta
 
 
+def is_reference_row(r, meta):
+    """The reference run: its own run ('reference-<hash>') or the sweep's run it coincides with."""
+    return r["name"].startswith("reference-") or (bool(meta.get("reference_run")) and r["name"] == meta["reference_run"])
+
+
 def num(s):
     try:
         v = float(s)
@@ -1170,7 +1183,7 @@ def plot_work_precision(plt, d, rows, meta, cfg):
     xkey = cfg.get("x", "wall_time")
     color_key = cfg.get("color", "coupling.algorithm")
     line_keys = cfg.get("lines", [k for k in meta.get("varied", []) if k not in ("time.dt", "fluid.mesh.size")])
-    pts = [r for r in rows if r["name"] and not r["name"].startswith("reference-") and num(r.get(metric))
+    pts = [r for r in rows if r["name"] and not is_reference_row(r, meta) and num(r.get(metric))
            and num(r.get(xkey))]
     if not pts:
         return None
@@ -1262,8 +1275,8 @@ def plot_histories(plt, d, rows, meta, cfg):
     if not probes:
         return []
     done = [r for r in rows if r.get("outcome") == "completed"]
-    ref = [r for r in done if r["name"].startswith("reference-")]
-    others = [r for r in done if not r["name"].startswith("reference-")]
+    ref = [r for r in done if is_reference_row(r, meta)]
+    others = [r for r in done if not is_reference_row(r, meta)]
     sel = cfg.get("select")
     if sel:
         keep = []

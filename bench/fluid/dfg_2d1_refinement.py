@@ -2,7 +2,7 @@
 """DFG 2D-1 mesh refinement: DOFs, errors of C_D, C_L, dp against Schafer-Turek, wall time.
 
 Usage (from the repository root, after building fluid_run):
-  python3 bench/fluid/dfg_2d1_refinement.py --runner build-fluid/bin/fluid_run --out out/dfg_2d1_refinement
+  python3 bench/fluid/dfg_2d1_refinement.py --runner build/bin/fluid_run --out out/dfg_2d1_refinement
 
 Writes OUT/table.md, OUT/results.json and OUT/error_vs_wall_time.png (the plot needs
 matplotlib: the system /usr/bin/python3 has it; re-plot with --plot-only).
@@ -20,7 +20,7 @@ LEVELS = [(0.04, 0.005), (0.02, 0.0025), (0.01, 0.00125)]
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--runner", default="build-fluid/bin/fluid_run")
+    ap.add_argument("--runner", default="build/bin/fluid_run")
     ap.add_argument("--scene", default="configs/dfg_2d1.yaml")
     ap.add_argument("--out", default="out/dfg_2d1_refinement")
     ap.add_argument("--levels", type=int, default=len(LEVELS))

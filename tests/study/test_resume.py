@@ -41,6 +41,22 @@ check(results(out) == rows, "the table is identical after resuming")
 study.write_text(study.read_text().replace("[0, 100]", "[0, 10]"))
 p = run_tool("run", str(study), "--out", str(out), "--fsi", FSI)
 check("2 run(s) started, 2 done before" in p.stderr, "a changed value reruns only the 2 new runs")
+# A reference run equal to one of the sweep's runs is that run: nothing is run again, the run
+# stays one of the cases, and every error is measured against it.
+study.write_text(study.read_text().replace(
+    "reference:\n  closed_form: {solid.d_x: sdof_exact}",
+    "reference:\n  run: {coupling.algorithm: 1, coupling.gamma_n1: 0}"))
+p = run_tool("run", str(study), "--out", str(out), "--fsi", FSI)
+check("0 run(s) started, 4 done before" in p.stderr, "a shared reference run is not run again")
+rows = results(out)
+meta = __import__("json").loads((out / "results.json").read_text())
+ref = [r for r in rows if r["name"] == meta["reference_run"]]
+check(len(rows) == 4 and len(ref) == 1 and ref[0]["coupling.algorithm"] == "1" and ref[0]["coupling.gamma_n1"] == "0",
+      f"the reference is the sweep's Alg 1, gamma 0 run ({meta['reference_run']})")
+check(outcomes(out)["cases"] == 4, "the shared reference is still counted as a case")
+err = {(r["coupling.algorithm"], r["coupling.gamma_n1"]): float(r["solid.d_x.l2_rel"]) for r in rows}
+check(err[("1", "0")] == 0.0 and err[("1", "10")] < 1e-12, "Alg 1 runs coincide with the reference")
+check(err[("2", "10")] > 1e-3, f"Alg 2, gamma 10 differs from it ({err[('2', '10')]:.4f})")
 
 # Time limit: a long run is killed and classified 'timeout', leaving no process behind.
 slow = w / "slow.yaml"
