@@ -1176,43 +1176,51 @@ def num(s):
 
 
 def plot_work_precision(plt, d, rows, meta, cfg):
+    """Error against wall time, one line per group of `lines`; `metric` is one column or a list
+    of columns (one panel each, e.g. a displacement amplitude and a force frequency)."""
     probes = meta.get("probes") or []
     if not probes:
         return None
-    metric = cfg.get("metric", f"{probes[0]}.l2_rel")
+    metrics = cfg.get("metric", f"{probes[0]}.l2_rel")
+    metrics = [metrics] if isinstance(metrics, str) else list(metrics)
     xkey = cfg.get("x", "wall_time")
     color_key = cfg.get("color", "coupling.algorithm")
     line_keys = cfg.get("lines", [k for k in meta.get("varied", []) if k not in ("time.dt", "fluid.mesh.size")])
-    pts = [r for r in rows if r["name"] and not is_reference_row(r, meta) and num(r.get(metric))
-           and num(r.get(xkey))]
-    if not pts:
+    runs = [r for r in rows if r["name"] and not is_reference_row(r, meta) and num(r.get(xkey))]
+    if not any(num(r.get(m)) for r in runs for m in metrics):
         return None
-    fig, ax = plt.subplots(figsize=(7, 5))
-    groups = {}
-    for r in pts:
-        groups.setdefault(tuple(r.get(k, "") for k in line_keys), []).append(r)
-    colors = {}
+    fig, axes = plt.subplots(1, len(metrics), figsize=(7 if len(metrics) == 1 else 5.5 * len(metrics), 5),
+                             squeeze=False)
     cyc = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     markers = "osD^v<>px*h"
-    mk = {}
-    for g, rs in sorted(groups.items()):
-        rs.sort(key=lambda r: num(r[xkey]))
-        ckey = rs[0].get(color_key, "")
-        colors.setdefault(ckey, cyc[len(colors) % len(cyc)])
-        other = tuple(v for k, v in zip(line_keys, g) if k != color_key)
-        mk.setdefault(other, markers[len(mk) % len(markers)])
-        label = ", ".join(f"{ABBREV.get(k, k)}={v}" for k, v in zip(line_keys, g))
-        ax.loglog([num(r[xkey]) for r in rs], [max(num(r[metric]), 1e-300) for r in rs], "-", marker=mk[other],
-                  color=colors[ckey], label=label)
-        for r in rs:
-            if "time.dt" in r:
-                ax.annotate(f"dt={r['time.dt']}", (num(r[xkey]), num(r[metric])), fontsize=6, alpha=0.6,
-                            textcoords="offset points", xytext=(3, 3))
-    ax.set_xlabel("wall time [s]" if xkey == "wall_time" else xkey)
-    ax.set_ylabel(metric)
-    ax.set_title(cfg.get("title", f"{meta.get('study', '')}: error against wall time"))
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    colors, mk = {}, {}
+    for ax, metric in zip(axes[0], metrics):
+        groups = {}
+        for r in runs:
+            if num(r.get(metric)) is not None:
+                groups.setdefault(tuple(r.get(k, "") for k in line_keys), []).append(r)
+        for g, rs in sorted(groups.items()):
+            rs.sort(key=lambda r: num(r[xkey]))
+            ckey = rs[0].get(color_key, "")
+            colors.setdefault(ckey, cyc[len(colors) % len(cyc)])
+            other = tuple(v for k, v in zip(line_keys, g) if k != color_key)
+            mk.setdefault(other, markers[len(mk) % len(markers)])
+            label = ", ".join(f"{ABBREV.get(k, k)}={v}" for k, v in zip(line_keys, g))
+            ax.loglog([num(r[xkey]) for r in rs], [max(num(r[metric]), 1e-300) for r in rs], "-",
+                      marker=mk[other], color=colors[ckey], label=label)
+            for r in rs:
+                if "time.dt" in r:
+                    ax.annotate(f"dt={r['time.dt']}", (num(r[xkey]), num(r[metric])), fontsize=6, alpha=0.6,
+                                textcoords="offset points", xytext=(3, 3))
+        ax.set_xlabel("wall time [s]" if xkey == "wall_time" else xkey)
+        ax.set_ylabel(metric)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, ncol=1 if len(metrics) > 1 else 2)
+    title = cfg.get("title", f"{meta.get('study', '')}: error against wall time")
+    if len(metrics) == 1:
+        axes[0][0].set_title(title)
+    else:
+        fig.suptitle(title)
     fig.tight_layout()
     path = Path(d) / cfg.get("file", "work_precision.png")
     fig.savefig(path, dpi=120)
