@@ -893,7 +893,7 @@ def stability_table(study, records):
     series = list(st.get("series", []))
     groups = {}
     for r in records:
-        if r.get("is_reference") and not r.get("shared_reference"):
+        if r.get("is_reference"):
             continue
         g = tuple(r["params"].get(k) for k in series) + (r["params"].get(x),)
         others = tuple(sorted((k, v) for k, v in r["combo"].items() if k not in series and k not in (x, key)))
@@ -928,7 +928,7 @@ def outcome_counts(records):
     c = {"cases": 0, "completed": 0, "diverged": 0, "diverged_by_reason": {}, "mesh_tangled": 0,
          "solver_failed": 0, "failed": 0, "failed_by_reason": {}, "timeouts": 0, "crashes": 0, "nan_cells": 0}
     for r in records:
-        if r.get("is_reference") and not r.get("shared_reference"):
+        if r.get("is_reference"):
             continue
         c["cases"] += 1
         o = r["outcome"]
@@ -1062,8 +1062,8 @@ def analyse(study, out, runner_results, ref_spec):
     records = list(runner_results.values())
     ref_rec = runner_results.get(ref_spec["name"]) if ref_spec else None
     if ref_rec:
-        ref_rec["is_reference"] = True
-        ref_rec["shared_reference"] = bool(ref_spec.get("shared"))
+        # A run of its own is not one of the sweep's cases; a shared one is (results.json names it).
+        ref_rec["is_reference"] = not ref_spec.get("shared")
     ref_series = reference_series(study, out, ref_spec) if ref_rec and ref_rec["outcome"] == "completed" else None
     for r in records:
         r["metrics"] = run_metrics(study, out, r, ref_series)

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Resumability (a second invocation runs nothing), the time limit (a run past it is killed with
 its whole process tree and classified 'timeout'), and Ctrl-C (everything stops, exit 130)."""
+import json
 import os
 import signal
 import subprocess
@@ -49,7 +50,7 @@ study.write_text(study.read_text().replace(
 p = run_tool("run", str(study), "--out", str(out), "--fsi", FSI)
 check("0 run(s) started, 4 done before" in p.stderr, "a shared reference run is not run again")
 rows = results(out)
-meta = __import__("json").loads((out / "results.json").read_text())
+meta = json.loads((out / "results.json").read_text())
 ref = [r for r in rows if r["name"] == meta["reference_run"]]
 check(len(rows) == 4 and len(ref) == 1 and ref[0]["coupling.algorithm"] == "1" and ref[0]["coupling.gamma_n1"] == "0",
       f"the reference is the sweep's Alg 1, gamma 0 run ({meta['reference_run']})")
