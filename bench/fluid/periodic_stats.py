@@ -6,12 +6,24 @@ Usage:
       [--strouhal-scale 0.1] [--json OUT/stats.json]
 
 Uses the last `window` seconds; the frequency comes from the upward mean crossings
-(linearly interpolated) of each column; amplitude = (max - min) / 2 over whole periods.
+(linearly interpolated) of each column; amplitude = (max - min) / 2 over whole periods;
+"mean" is the time average, "midrange" = (max + min) / 2 (Turek & Hron's definition of the
+mean in their CFD/FSI tables).
+
+  --by-period lift   splits the window into the periods of that column (upward crossings of
+                     its mean) and prints every column's midrange / amplitude per period: the
+                     way to see whether a run has reached its periodic state.
+  --reference cfd3   prints the errors against a published reference (Turek & Hron 2006).
 """
 import argparse
 import csv
 import json
 import sys
+
+# (midrange mean, amplitude, frequency of the lift) per column
+REFERENCES = {
+    "cfd3": {"drag": (439.45, 5.6183, 4.3956), "lift": (-11.893, 437.81, 4.3956)},
+}
 
 
 def crossings(t, y, level):
@@ -34,8 +46,24 @@ def stats(t, y):
     ys = [p[1] for p in sel]
     mean = sum(ys) / len(ys)
     freq = (len(up) - 1) / (up[-1] - up[0])
-    return {"mean": mean, "max": max(ys), "min": min(ys), "amplitude": (max(ys) - min(ys)) / 2,
-            "frequency": freq, "periods": len(up) - 1}
+    return {"mean": mean, "max": max(ys), "min": min(ys), "midrange": (max(ys) + min(ys)) / 2,
+            "amplitude": (max(ys) - min(ys)) / 2, "frequency": freq, "periods": len(up) - 1}
+
+
+def by_period(t, cols, key):
+    """Per period of cols[key] (between successive upward crossings of its mean): for every
+    column (midrange, amplitude), and the period's duration."""
+    y = cols[key]
+    up = crossings(t, y, sum(y) / len(y))
+    out = []
+    for a, b in zip(up[:-1], up[1:]):
+        idx = [i for i, ti in enumerate(t) if a <= ti <= b]
+        row = {"t0": a, "t1": b, "frequency": 1.0 / (b - a)}
+        for c, v in cols.items():
+            vs = [v[i] for i in idx]
+            row[c] = {"midrange": (max(vs) + min(vs)) / 2, "amplitude": (max(vs) - min(vs)) / 2}
+        out.append(row)
+    return out
 
 
 def main():
@@ -44,9 +72,16 @@ def main():
     ap.add_argument("--columns", nargs="+", default=["cd", "cl"])
     ap.add_argument("--window", type=float, default=1.0)
     ap.add_argument("--strouhal-scale", type=float, default=0.0, help="D / U_bar: St = f * scale")
+    ap.add_argument("--by-period", metavar="COLUMN", help="print statistics per period of COLUMN")
+    ap.add_argument("--reference", choices=sorted(REFERENCES), help="print errors against a published reference")
     ap.add_argument("--json")
     a = ap.parse_args()
     rows = list(csv.DictReader(open(a.csv)))
+    if not rows:
+        sys.exit(f"periodic_stats: {a.csv}: no data rows")
+    missing = [c for c in a.columns + ([a.by_period] if a.by_period else []) if c not in rows[0]]
+    if missing:
+        sys.exit(f"periodic_stats: {a.csv}: no column {', '.join(missing)} (columns: {', '.join(rows[0])})")
     t = [float(r["time"]) for r in rows]
     t_end = t[-1]
     result = {"t_end": t_end, "window": a.window}
@@ -56,9 +91,39 @@ def main():
         if a.strouhal_scale:
             s["strouhal"] = s["frequency"] * a.strouhal_scale
         result[c] = s
-        print(f"{c:>6}: mean {s['mean']:.6g}  amplitude {s['amplitude']:.6g}  max {s['max']:.6g}  "
+        print(f"{c:>6}: mean {s['mean']:.6g}  midrange {s.get('midrange', float('nan')):.6g}  "
+              f"amplitude {s['amplitude']:.6g}  max {s['max']:.6g}  "
               f"min {s['min']:.6g}  frequency {s['frequency']:.5g} Hz ({s['periods']} periods)"
               + (f"  St {s['strouhal']:.5f}" if a.strouhal_scale else ""))
+    if a.reference:
+        ref = REFERENCES[a.reference]
+        # The published frequency is the lift's (the drag oscillates at twice it, plus a part at it).
+        fcol = "lift" if "lift" in result else a.columns[0]
+        f0 = result[fcol]["frequency"]
+        print(f"against {a.reference}: midrange +/- amplitude [frequency of {fcol}]")
+        for c in a.columns:
+            if c not in ref:
+                continue
+            m, amp, f = ref[c]
+            s = result[c]
+            e = {"midrange_over_amplitude_percent": 100 * (s.get("midrange", s["mean"]) - m) / amp,
+                 "midrange_percent": 100 * (s.get("midrange", s["mean"]) - m) / abs(m),
+                 "amplitude_percent": 100 * (s["amplitude"] - amp) / amp,
+                 "frequency_percent": 100 * (f0 - f) / f}
+            s["errors"] = e
+            print(f"{c:>6}: {s.get('midrange', s['mean']):.5g} +/- {s['amplitude']:.5g} [{f0:.5g}] vs "
+                  f"{m} +/- {amp} [{f}]: midrange {e['midrange_percent']:+.2f}% "
+                  f"({e['midrange_over_amplitude_percent']:+.2f}% of the amplitude), "
+                  f"amplitude {e['amplitude_percent']:+.2f}%, frequency {e['frequency_percent']:+.2f}%")
+    if a.by_period:
+        pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]
+        cols = {c: [float(rows[i][c]) for i in pts] for c in dict.fromkeys([a.by_period] + a.columns)}
+        periods = by_period([t[i] for i in pts], cols, a.by_period)
+        result["by_period"] = periods
+        print(f"per period of {a.by_period}: " + "  ".join(f"{c} midrange +/- amplitude" for c in cols))
+        for p in periods:
+            print(f"  [{p['t0']:8.4f}, {p['t1']:8.4f}] {p['frequency']:.4f} Hz  " +
+                  "  ".join(f"{p[c]['midrange']:10.4f} +/- {p[c]['amplitude']:9.4f}" for c in cols))
     if "cl" in a.columns and "dp" in a.columns and result["cl"]["frequency"] == result["cl"]["frequency"]:
         # DFG 2D-2: dp at t0 + 1/(2f), t0 = time of the last complete C_L maximum.
         pts = [(ti, float(r["cl"]), float(r["dp"])) for ti, r in zip(t, rows)]
