@@ -25,6 +25,8 @@ def main():
     ap.add_argument("--out", default="out/dfg_2d1_refinement")
     ap.add_argument("--levels", type=int, default=len(LEVELS))
     ap.add_argument("--plot-only", action="store_true", help="re-plot OUT/results.json")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="extra scene override for every level (repeatable)")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     if a.plot_only:
@@ -34,6 +36,8 @@ def main():
         run_dir = os.path.join(a.out, f"h{h:g}")
         cmd = [a.runner, a.scene, "--out", run_dir, "--set", f"fluid.mesh.size={h}",
                "--set", f"fluid.mesh.parameters.hc={hc}", "--set", "fluid.output.vtk_every=0"]
+        for kv in a.set:
+            cmd += ["--set", kv]
         # Mesh first (cached), so the timed run measures the solver only.
         t0 = time.time()
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

@@ -135,6 +135,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
     s.viscous_constant = st->get<double>("viscous_constant", s.viscous_constant);
     s.transient_tau = st->get<bool>("transient_tau", s.transient_tau);
+    s.viscous_residual = st->get<bool>("viscous_residual", s.viscous_residual);
   }
   params.threads = section.get<int>("threads", params.threads);
   params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);

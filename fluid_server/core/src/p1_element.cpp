@@ -56,13 +56,15 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
     const Eigen::RowVector2d hist = N.transpose() * in.history;
     const Eigen::RowVector2d f = N.transpose() * in.force;
     const Eigen::Vector3d adv = dN * a.transpose();  // a . grad N_k
-    // rhs of the residual: f - rho history (per component)
+    // rhs of the residual: f - rho history (per component); the stabilisation terms also get the
+    // known viscous part of the strong residual (zero unless reconstructed).
     const Eigen::RowVector2d src = f - rho * hist;
+    const Eigen::RowVector2d src_stab = src + in.viscous;
     for (int i = 0; i < 3; ++i) {
       for (int c = 0; c < 2; ++c) {
-        out.rhs(3 * i + c) += w * (N(i) + tau_supg * adv(i)) * src(c);
+        out.rhs(3 * i + c) += w * (N(i) * src(c) + tau_supg * adv(i) * src_stab(c));
       }
-      out.rhs(3 * i + 2) += w * (tau_pspg / rho) * dN.row(i).dot(src);
+      out.rhs(3 * i + 2) += w * (tau_pspg / rho) * dN.row(i).dot(src_stab);
       for (int j = 0; j < 3; ++j) {
         const double transport = rho * (in.alpha0_dt * N(j) + adv(j));  // rho(alpha0/dt N_j + a.grad N_j)
         const double vel = w * (N(i) * transport + mu * dN.row(i).dot(dN.row(j)) + tau_supg * adv(i) * transport);

@@ -8,8 +8,11 @@
 //   (w, rho(alpha0/dt u + a.grad u)) + (mu grad w, grad u) - (div w, p) + (q, div u)
 //   + sum_K (tau_M (a.grad w + grad q / rho), r_M)_K + sum_K (tau_C rho div w, div u)_K
 //   = (w, f - rho history/dt) + stabilisation right-hand side,
-// with the strong residual r_M = rho(alpha0/dt u + history/dt + a.grad u) + grad p - f (the
-// viscous term vanishes inside linear elements).
+// with the strong residual r_M = rho(alpha0/dt u + history/dt + a.grad u) + grad p - div(mu grad u) - f.
+// The viscous term vanishes inside linear elements; with `viscous_residual` the caller passes
+// div(mu grad u*) reconstructed from the L2-projected nodal gradient of the linearisation
+// velocity u* (Jansen, Collis, Whiting & Shakib, CMAME 174 (1999) 153), which restores the
+// consistency of SUPG/PSPG in boundary layers (explicit in u*, so the matrix is unchanged).
 #include <Eigen/Core>
 
 namespace fsi::fluid {
@@ -20,6 +23,7 @@ struct StabilisationParameters {
   double lsic_scale = 1.0;        // multiplies tau_C = h^2 / (8 tau_M); 0 switches LSIC off
   double viscous_constant = 3.0;  // c in tau_M^-2 = (2/dt)^2 + (2|a|/h)^2 + (c 4 nu/h^2)^2
   bool transient_tau = true;      // include the (2/dt)^2 term
+  bool viscous_residual = false;  // include the reconstructed div(mu grad u*) in r_M (ElementInput::viscous)
 };
 
 struct ElementInput {
@@ -27,6 +31,7 @@ struct ElementInput {
   Eigen::Matrix<double, 3, 2> advection;  // a = u* - w at the nodes
   Eigen::Matrix<double, 3, 2> history;    // (alpha1 u_n + alpha2 u_{n-1}) / dt at the nodes (0 if steady)
   Eigen::Matrix<double, 3, 2> force;      // body force f at the nodes
+  Eigen::RowVector2d viscous = Eigen::RowVector2d::Zero();  // div(mu grad u*) in the element (0: not reconstructed)
   double density = 1;
   double viscosity = 1;  // dynamic
   double alpha0_dt = 0;  // alpha0 / dt (0 if steady)
