@@ -36,7 +36,7 @@ import yaml
 TOOL_DIR = Path(__file__).resolve().parent
 REPO = TOOL_DIR.parent
 
-STUDY_KEYS = {"study", "description", "scene", "fixed", "vary", "zip", "derived", "where", "time_limit",
+STUDY_KEYS = {"extends", "study", "description", "scene", "fixed", "vary", "zip", "derived", "where", "time_limit",
               "probes", "reference", "metrics", "stability", "plots"}
 FINISHED = ("completed", "diverged", "failed")
 ABBREV = {"coupling.algorithm": "alg", "coupling.gamma_n1": "g", "coupling.relaxation": "beta",
@@ -375,15 +375,39 @@ def expand(key, values):
     raise StudyError(f"vary '{key}': a list, or one of {{linspace|geomspace|range: [a, b, n|step]}}")
 
 
+def load_study_file(path, seen=()):
+    """The study file as a mapping; `extends: OTHER.yaml` (relative to this file) takes every
+    top-level key of OTHER that this file does not set (a second reference or other plots for
+    the same sweep without copying it). The inherited scene is resolved relative to OTHER."""
+    path = Path(path).resolve()
+    if path in seen:
+        raise StudyError(f"{path}: 'extends' cycle ({' -> '.join(str(p) for p in seen + (path,))})")
+    try:
+        d = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError) as e:
+        raise StudyError(f"{path}: {e}") from None
+    if not isinstance(d, dict):
+        raise StudyError(f"{path}: not a mapping")
+    parent_name = d.pop("extends", None)
+    if parent_name is None:
+        return d
+    parent_path = (path.parent / str(parent_name)).resolve()
+    if not parent_path.is_file():
+        raise StudyError(f"{path}: extends '{parent_name}': no such file ({parent_path})")
+    parent = load_study_file(parent_path, seen + (path,))
+    if "scene" in parent and not Path(str(parent["scene"])).is_absolute():
+        c = parent_path.parent / str(parent["scene"])
+        if c.is_file():
+            parent["scene"] = str(c.resolve())
+    merged = dict(parent)
+    merged.update(d)
+    return merged
+
+
 class Study:
     def __init__(self, path):
         self.path = Path(path).resolve()
-        try:
-            d = yaml.safe_load(self.path.read_text())
-        except (OSError, yaml.YAMLError) as e:
-            raise StudyError(f"{path}: {e}") from None
-        if not isinstance(d, dict):
-            raise StudyError(f"{path}: not a mapping")
+        d = load_study_file(self.path)
         unknown = sorted(set(d) - STUDY_KEYS)
         if unknown:
             raise StudyError(f"{path}: unknown key(s) {unknown}; known: {sorted(STUDY_KEYS)}")

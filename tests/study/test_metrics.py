@@ -73,4 +73,26 @@ check(c["outcome"] == "mesh tangled", "a tangled mesh is its own outcome")
 check(fs.classify(None, -11, "finished")["outcome"] == "crashed", "a signal exit is a crash")
 check(fs.classify(None, 0, "finished")["outcome"] == "crashed", "a missing summary.json is a crash")
 check(fs.classify({"status": "completed"}, 0, "timeout")["outcome"] == "timeout", "past the time limit: timeout")
+# `extends`: a second reference for the same sweep without copying it.
+a, b = fs.Study(common.SRC / "studies" / "fsi3.yaml"), fs.Study(common.SRC / "studies" / "fsi3_published.yaml")
+na, nb = [a.spec(x)["name"] for x in a.combos()], [b.spec(x)["name"] for x in b.combos()]
+check(len(na) == 10 and na == nb, f"extends: the same {len(na)} runs (names) as the parent study")
+check("run" in a.reference and "values" in b.reference and b.window == a.window and b.scene == a.scene,
+      "extends: own reference, inherited window and scene (resolved relative to the parent)")
+import tempfile  # noqa: E402
+from pathlib import Path  # noqa: E402
+with tempfile.TemporaryDirectory() as tmp:
+    (Path(tmp) / "x.yaml").write_text("extends: y.yaml\n")
+    (Path(tmp) / "y.yaml").write_text("extends: x.yaml\n")
+    try:
+        fs.Study(Path(tmp) / "x.yaml")
+        check(False, "an extends cycle is an error")
+    except fs.StudyError as e:
+        check("cycle" in str(e), f"an extends cycle is named: {e}")
+    (Path(tmp) / "z.yaml").write_text("extends: missing.yaml\n")
+    try:
+        fs.Study(Path(tmp) / "z.yaml")
+        check(False, "a missing parent is an error")
+    except fs.StudyError as e:
+        check("missing.yaml" in str(e), f"a missing parent is named: {e}")
 print("all metric tests passed")
