@@ -14,10 +14,13 @@ mean in their CFD/FSI tables).
                      its mean) and prints every column's midrange / amplitude per period: the
                      way to see whether a run has reached its periodic state.
   --reference cfd3   prints the errors against a published reference (Turek & Hron 2006).
+  --harmonics 3      least-squares amplitudes of every column at 1, 2, 3 x the lift frequency
+                     (CFD3: the drag oscillates at f and 2f; its f part follows the lift mean).
 """
 import argparse
 import csv
 import json
+import math
 import sys
 
 # (midrange mean, amplitude, frequency of the lift) per column
@@ -50,6 +53,17 @@ def stats(t, y):
             "amplitude": (max(ys) - min(ys)) / 2, "frequency": freq, "periods": len(up) - 1}
 
 
+def harmonic_amplitudes(t, y, f, n):
+    """Amplitudes of y at f, 2f, ..., nf: least squares of a0 + sum (a_k cos + b_k sin)(2 pi k f t)."""
+    import numpy as np
+    t, y = np.asarray(t), np.asarray(y)
+    cols = [np.ones_like(t)]
+    for k in range(1, n + 1):
+        cols += [np.cos(2 * math.pi * k * f * t), np.sin(2 * math.pi * k * f * t)]
+    c, *_ = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)
+    return [float(math.hypot(c[2 * k - 1], c[2 * k])) for k in range(1, n + 1)]
+
+
 def by_period(t, cols, key):
     """Per period of cols[key] (between successive upward crossings of its mean): for every
     column (midrange, amplitude), and the period's duration."""
@@ -74,6 +88,8 @@ def main():
     ap.add_argument("--strouhal-scale", type=float, default=0.0, help="D / U_bar: St = f * scale")
     ap.add_argument("--by-period", metavar="COLUMN", help="print statistics per period of COLUMN")
     ap.add_argument("--reference", choices=sorted(REFERENCES), help="print errors against a published reference")
+    ap.add_argument("--harmonics", type=int, default=0, metavar="N",
+                    help="amplitudes at 1..N times the frequency of the lift (or the first column)")
     ap.add_argument("--json")
     a = ap.parse_args()
     rows = list(csv.DictReader(open(a.csv)))
@@ -115,6 +131,17 @@ def main():
                   f"{m} +/- {amp} [{f}]: midrange {e['midrange_percent']:+.2f}% "
                   f"({e['midrange_over_amplitude_percent']:+.2f}% of the amplitude), "
                   f"amplitude {e['amplitude_percent']:+.2f}%, frequency {e['frequency_percent']:+.2f}%")
+    if a.harmonics > 0:
+        fcol = "lift" if "lift" in result else a.columns[0]
+        f0 = result[fcol]["frequency"]
+        pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]
+        tw = [t[i] for i in pts]
+        print(f"harmonics of f = {f0:.5g} Hz (frequency of {fcol}), least squares over the window:")
+        for c in a.columns:
+            ys = [float(rows[i][c]) for i in pts]
+            amps = harmonic_amplitudes(tw, ys, f0, a.harmonics)
+            result[c]["harmonics"] = amps
+            print(f"{c:>6}: " + "  ".join(f"{k + 1}f {v:.5g}" for k, v in enumerate(amps)))
     if a.by_period:
         pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]
         cols = {c: [float(rows[i][c]) for i in pts] for c in dict.fromkeys([a.by_period] + a.columns)}

@@ -56,6 +56,15 @@ check(abs(e["amplitude_percent"] - 100 * (5.0 - 5.6183) / 5.6183) < 0.02,
 check(abs(e["frequency_percent"] - 100 * (f - 4.3956) / 4.3956) < 1e-3,
       f"frequency error (the lift's) {e['frequency_percent']:.4f}% = {100 * (f - 4.3956) / 4.3956:.4f}%")
 
+# Harmonics: the drag is all 2f (amplitude 5), the lift all f (430 after t = 2).
+p4 = subprocess.run(["/usr/bin/python3", str(SCRIPT), str(csv_path), "--columns", "drag", "lift", "--window", "1.5",
+                     "--harmonics", "3", "--json", str(out)], capture_output=True, text=True, timeout=60)
+check(p4.returncode == 0, f"--harmonics: exit code {p4.returncode} ({p4.stderr.strip()[-300:]})")
+h = json.load(open(out))
+hd, hl = h["drag"]["harmonics"], h["lift"]["harmonics"]
+check(abs(hd[0]) < 1e-3 and abs(hd[1] - 5.0) < 1e-3 and abs(hd[2]) < 1e-3, f"drag harmonics {hd} = [0, 5, 0]")
+check(abs(hl[0] - 430.0) < 1e-2 and abs(hl[1]) < 1e-2, f"lift harmonics {hl} = [430, 0, 0]")
+
 # Per period of the lift over the whole run: 400 before t = 2, 430 after (one period straddles).
 p2 = subprocess.run(["/usr/bin/python3", str(SCRIPT), str(csv_path), "--columns", "drag", "lift", "--window", "4",
                      "--by-period", "lift", "--json", str(out)], capture_output=True, text=True, timeout=60)
