@@ -42,7 +42,8 @@ def stats(t, y):
     mean = sum(y) / len(y)
     up = crossings(t, y, mean)
     if len(up) < 3:
-        return {"mean": mean, "max": max(y), "min": min(y), "amplitude": (max(y) - min(y)) / 2,
+        return {"mean": mean, "max": max(y), "min": min(y), "midrange": (max(y) + min(y)) / 2,
+                "amplitude": (max(y) - min(y)) / 2,
                 "frequency": float("nan"), "periods": max(0, len(up) - 1)}
     # restrict to whole periods
     sel = [(ti, yi) for ti, yi in zip(t, y) if up[0] <= ti <= up[-1]]
@@ -107,34 +108,32 @@ def main():
         if a.strouhal_scale:
             s["strouhal"] = s["frequency"] * a.strouhal_scale
         result[c] = s
-        print(f"{c:>6}: mean {s['mean']:.6g}  midrange {s.get('midrange', float('nan')):.6g}  "
+        print(f"{c:>6}: mean {s['mean']:.6g}  midrange {s['midrange']:.6g}  "
               f"amplitude {s['amplitude']:.6g}  max {s['max']:.6g}  "
               f"min {s['min']:.6g}  frequency {s['frequency']:.5g} Hz ({s['periods']} periods)"
               + (f"  St {s['strouhal']:.5f}" if a.strouhal_scale else ""))
+    # The published frequency is the lift's (the drag oscillates at twice it, plus a part at it).
+    fcol = "lift" if "lift" in result else a.columns[0]
+    f0 = result[fcol]["frequency"]
+    pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]  # rows of the window
     if a.reference:
         ref = REFERENCES[a.reference]
-        # The published frequency is the lift's (the drag oscillates at twice it, plus a part at it).
-        fcol = "lift" if "lift" in result else a.columns[0]
-        f0 = result[fcol]["frequency"]
         print(f"against {a.reference}: midrange +/- amplitude [frequency of {fcol}]")
         for c in a.columns:
             if c not in ref:
                 continue
             m, amp, f = ref[c]
             s = result[c]
-            e = {"midrange_over_amplitude_percent": 100 * (s.get("midrange", s["mean"]) - m) / amp,
-                 "midrange_percent": 100 * (s.get("midrange", s["mean"]) - m) / abs(m),
+            e = {"midrange_over_amplitude_percent": 100 * (s["midrange"] - m) / amp,
+                 "midrange_percent": 100 * (s["midrange"] - m) / abs(m),
                  "amplitude_percent": 100 * (s["amplitude"] - amp) / amp,
                  "frequency_percent": 100 * (f0 - f) / f}
             s["errors"] = e
-            print(f"{c:>6}: {s.get('midrange', s['mean']):.5g} +/- {s['amplitude']:.5g} [{f0:.5g}] vs "
+            print(f"{c:>6}: {s['midrange']:.5g} +/- {s['amplitude']:.5g} [{f0:.5g}] vs "
                   f"{m} +/- {amp} [{f}]: midrange {e['midrange_percent']:+.2f}% "
                   f"({e['midrange_over_amplitude_percent']:+.2f}% of the amplitude), "
                   f"amplitude {e['amplitude_percent']:+.2f}%, frequency {e['frequency_percent']:+.2f}%")
     if a.harmonics > 0:
-        fcol = "lift" if "lift" in result else a.columns[0]
-        f0 = result[fcol]["frequency"]
-        pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]
         tw = [t[i] for i in pts]
         print(f"harmonics of f = {f0:.5g} Hz (frequency of {fcol}), least squares over the window:")
         for c in a.columns:
@@ -143,7 +142,6 @@ def main():
             result[c]["harmonics"] = amps
             print(f"{c:>6}: " + "  ".join(f"{k + 1}f {v:.5g}" for k, v in enumerate(amps)))
     if a.by_period:
-        pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]
         cols = {c: [float(rows[i][c]) for i in pts] for c in dict.fromkeys([a.by_period] + a.columns)}
         periods = by_period([t[i] for i in pts], cols, a.by_period)
         result["by_period"] = periods

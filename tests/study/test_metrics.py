@@ -81,18 +81,20 @@ check("run" in a.reference and "values" in b.reference and b.window == a.window 
       "extends: own reference, inherited window and scene (resolved relative to the parent)")
 import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
+
+
+def expect_study_error(path, needle, what):
+    try:
+        fs.Study(path)
+        check(False, what)
+    except fs.StudyError as e:
+        check(needle in str(e), f"{what}, named: {e}")
+
+
 with tempfile.TemporaryDirectory() as tmp:
     (Path(tmp) / "x.yaml").write_text("extends: y.yaml\n")
     (Path(tmp) / "y.yaml").write_text("extends: x.yaml\n")
-    try:
-        fs.Study(Path(tmp) / "x.yaml")
-        check(False, "an extends cycle is an error")
-    except fs.StudyError as e:
-        check("cycle" in str(e), f"an extends cycle is named: {e}")
+    expect_study_error(Path(tmp) / "x.yaml", "cycle", "an extends cycle is an error")
     (Path(tmp) / "z.yaml").write_text("extends: missing.yaml\n")
-    try:
-        fs.Study(Path(tmp) / "z.yaml")
-        check(False, "a missing parent is an error")
-    except fs.StudyError as e:
-        check("missing.yaml" in str(e), f"a missing parent is named: {e}")
+    expect_study_error(Path(tmp) / "z.yaml", "missing.yaml", "a missing parent is an error")
 print("all metric tests passed")

@@ -59,6 +59,44 @@ class FrozenLuPreconditioner {
   const LuSolver* lu_ = nullptr;
 };
 
+// div(mu grad u) per element (rows: triangles; constant in each), from the nodal gradients of
+// the P1 velocity u (interleaved u, v, p) by lumped L2 projection:
+// G_i = sum_e |e|/3 grad u_e / sum_e |e|/3. Degenerate elements get 0 (the assembly reports them).
+Eigen::MatrixX2d element_viscous_term(const FluidMesh& mesh, const Eigen::MatrixX2d& X, const Eigen::VectorXd& u,
+                                      double mu) {
+  const int n = mesh.node_count(), ne = mesh.triangle_count();
+  Eigen::MatrixXd grad = Eigen::MatrixXd::Zero(n, 4);  // du/dx, du/dy, dv/dx, dv/dy
+  Eigen::VectorXd lumped = Eigen::VectorXd::Zero(n);
+  std::vector<TriangleGeometry> geo(static_cast<std::size_t>(ne));
+  for (int e = 0; e < ne; ++e) {
+    Eigen::Matrix<double, 3, 2> x;
+    for (int k = 0; k < 3; ++k) x.row(k) = X.row(mesh.triangles(e, k));
+    const auto& g = geo[static_cast<std::size_t>(e)] = triangle_geometry(x);
+    if (!(g.area > 0)) continue;
+    Eigen::Matrix2d gu = Eigen::Matrix2d::Zero();  // row c: grad of component c
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 2; ++c) gu.row(c) += u(3 * mesh.triangles(e, k) + c) * g.grad.row(k);
+    for (int k = 0; k < 3; ++k) {
+      const int node = mesh.triangles(e, k);
+      lumped(node) += g.area / 3.0;
+      grad.row(node) += g.area / 3.0 * Eigen::RowVector4d(gu(0, 0), gu(0, 1), gu(1, 0), gu(1, 1));
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    if (lumped(i) > 0) grad.row(i) /= lumped(i);
+  Eigen::MatrixX2d out = Eigen::MatrixX2d::Zero(ne, 2);
+  for (int e = 0; e < ne; ++e) {
+    const auto& g = geo[static_cast<std::size_t>(e)];
+    if (!(g.area > 0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int node = mesh.triangles(e, k);
+      out(e, 0) += grad(node, 0) * g.grad(k, 0) + grad(node, 1) * g.grad(k, 1);
+      out(e, 1) += grad(node, 2) * g.grad(k, 0) + grad(node, 3) * g.grad(k, 1);
+    }
+  }
+  return mu * out;
+}
+
 }  // namespace
 
 struct NavierStokesSolver::Impl {
@@ -264,49 +302,13 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
   impl_->thread_values.resize(static_cast<std::size_t>(nthreads));
   Eigen::VectorXd rhs(ndof), rhs_volume(ndof);
 
-  // Reconstructed viscous residual: nodal gradients of u* by lumped L2 projection
-  // (G_i = sum_e |e|/3 grad u*_e / sum_e |e|/3), then div(mu G) per element (constant).
+  // Reconstructed viscous residual (div(mu grad u*) per element), see element_viscous_term.
   const bool reconstruct = params_.stabilisation.viscous_residual && (params_.stabilisation.supg || params_.stabilisation.pspg);
-  Eigen::MatrixXd element_viscous;  // triangles x 2
-  auto reconstruct_viscous = [&](const Eigen::VectorXd& u) {
-    const int ne = mesh_.triangle_count();
-    Eigen::MatrixXd grad = Eigen::MatrixXd::Zero(n, 4);  // du/dx, du/dy, dv/dx, dv/dy
-    Eigen::VectorXd lumped = Eigen::VectorXd::Zero(n);
-    std::vector<TriangleGeometry> geo(static_cast<std::size_t>(ne));
-    for (int e = 0; e < ne; ++e) {
-      Eigen::Matrix<double, 3, 2> x;
-      for (int k = 0; k < 3; ++k) x.row(k) = X_.row(mesh_.triangles(e, k));
-      const auto& g = geo[static_cast<std::size_t>(e)] = triangle_geometry(x);
-      if (!(g.area > 0)) continue;  // reported by the assembly below
-      Eigen::Matrix2d gu = Eigen::Matrix2d::Zero();  // row c: grad of component c
-      for (int k = 0; k < 3; ++k) {
-        const int node = mesh_.triangles(e, k);
-        for (int c = 0; c < 2; ++c) gu.row(c) += u(3 * node + c) * g.grad.row(k);
-      }
-      for (int k = 0; k < 3; ++k) {
-        const int node = mesh_.triangles(e, k);
-        lumped(node) += g.area / 3.0;
-        grad.row(node) += g.area / 3.0 * Eigen::RowVector4d(gu(0, 0), gu(0, 1), gu(1, 0), gu(1, 1));
-      }
-    }
-    for (int i = 0; i < n; ++i)
-      if (lumped(i) > 0) grad.row(i) /= lumped(i);
-    element_viscous.setZero(ne, 2);
-    for (int e = 0; e < ne; ++e) {
-      const auto& g = geo[static_cast<std::size_t>(e)];
-      if (!(g.area > 0)) continue;
-      for (int k = 0; k < 3; ++k) {
-        const int node = mesh_.triangles(e, k);
-        element_viscous(e, 0) += grad(node, 0) * g.grad(k, 0) + grad(node, 1) * g.grad(k, 1);
-        element_viscous(e, 1) += grad(node, 2) * g.grad(k, 0) + grad(node, 3) * g.grad(k, 1);
-      }
-    }
-    element_viscous *= params_.viscosity;
-  };
+  Eigen::MatrixX2d element_viscous;
 
   for (int iteration = 1; iteration <= std::max(1, params_.max_iterations); ++iteration) {
     const auto t_assembly = Clock::now();
-    if (reconstruct) reconstruct_viscous(U_adv);
+    if (reconstruct) element_viscous = element_viscous_term(mesh_, X_, U_adv, params_.viscosity);
     std::vector<Eigen::VectorXd> thread_rhs(static_cast<std::size_t>(nthreads), Eigen::VectorXd::Zero(ndof));
     int bad_element = -1;
     double bad_area = 0;
