@@ -87,6 +87,13 @@ int main(int argc, char** argv) {
                            "  \"steps\": {},\n  \"linear_solves\": {},\n  \"setup_seconds\": {:.3f},\n  \"wall_seconds\": {:.3f}",
                            name, model.solver().dofs(), model.solver().mesh().node_count(),
                            model.solver().mesh().triangle_count(), steps, iterations, setup_seconds, wall);
+    summary << ",\n  \"fluid_breakdown\": {";
+    bool first = true;
+    for (const auto& [k, v] : model.timings()) {
+      summary << fmt::format("{}\"{}\": {:.4f}", first ? "" : ", ", k, v);
+      first = false;
+    }
+    summary << "}";
     for (const auto& [k, v] : probes) summary << fmt::format(",\n  \"final_{}\": {:.10g}", k, v);
     summary << "\n}\n";
     log->info("{}: {} steps, {} solves, {} unknowns, wall {:.1f}s", name, steps, iterations, model.solver().dofs(), wall);

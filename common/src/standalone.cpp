@@ -45,12 +45,14 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
       report.data()["steps"] = steps_done;
       if (n == time.steps || n % 10 == 0) {
         report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
+        if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
         report.write();
       }
       progress.update(n, info.time);
     }
     report.set_status("completed");
     report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
+        if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
   } catch (const ConfigError& e) {
     report.set_status("failed", std::string("configuration: ") + e.what());
   } catch (const SolverError& e) {
@@ -60,6 +62,7 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
   }
   report.data()["steps"] = steps_done;
   report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
+        if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
   report.write();
   const std::string status = report.data()["status"];
   if (status != "completed") {

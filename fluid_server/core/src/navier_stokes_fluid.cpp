@@ -13,6 +13,7 @@
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
+#include "fsi/fluid/taylor_hood_solver.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -65,8 +66,9 @@ std::string read_text(const std::filesystem::path& path) {
 }  // namespace
 
 std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
-                               const std::filesystem::path& cache_dir) {
+                               const std::filesystem::path& cache_dir, int order) {
   std::string key = read_text(geo);
+  if (order != 1) key += fmt::format("\norder={}", order);
   for (const auto& [name, value] : parameters) key += fmt::format("\n{}={:.17g}", name, value);
   const auto hash = std::hash<std::string>{}(key);
   std::filesystem::create_directories(cache_dir);
@@ -75,6 +77,7 @@ std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<
   const auto tmp = cache_dir / fmt::format("{}_{:016x}.{}.tmp.msh", geo.stem().string(), hash, ::getpid());
   const auto log_file = cache_dir / fmt::format("{}_{:016x}.log", geo.stem().string(), hash);
   std::string cmd = "gmsh -2 -format msh22 -v 2";
+  if (order != 1) cmd += fmt::format(" -order {}", order);
   for (const auto& [name, value] : parameters) cmd += fmt::format(" -setnumber {} {:.17g}", name, value);
   cmd += fmt::format(" '{}' -o '{}' > '{}' 2>&1", geo.string(), tmp.string(), log_file.string());
   fsi::logger("fluid")->info("meshing {} ({})", geo.filename().string(), cmd);
@@ -91,6 +94,11 @@ NavierStokesFluid::~NavierStokesFluid() = default;
 void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup& setup) {
   auto log = fsi::logger("fluid");
   setup_ = setup;
+  // --- element ---
+  const auto element = section.get<std::string>("element", "p1p1");
+  if (element != "p1p1" && element != "p2p1") section.fail("element", "must be p1p1 or p2p1, got '" + element + "'");
+  const bool taylor_hood = element == "p2p1";
+
   // --- mesh ---
   const auto mesh_section = section.child("mesh");
   std::filesystem::path msh;
@@ -106,10 +114,18 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     std::filesystem::path cache = setup.output_dir.empty() ? std::filesystem::temp_directory_path() / "fsi_fluid_meshes"
                                                            : setup.output_dir / "meshes";
     if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
-    msh = mesh_geo(geo, parameters, cache);
+    msh = mesh_geo(geo, parameters, cache, taylor_hood ? 2 : 1);
   }
   const auto domain = string_list(mesh_section, "domain");
   FluidMesh mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
+  if (taylor_hood && !mesh.quadratic()) {
+    log->info("fluid: {} has 3-node triangles; the P2/P1 elements get straight edges (mesh with gmsh -order 2 for "
+              "curved boundaries)", msh.string());
+    mesh = mesh.quadratic_from_linear();
+  } else if (!taylor_hood && mesh.quadratic()) {
+    mesh_section.fail(mesh_section.has("file") ? "file" : "geo",
+                      "the mesh has 6-node triangles, the P1/P1 fluid needs 3-node ones (or set fluid.element: p2p1)");
+  }
 
   // --- physics and numerics ---
   FlowParameters params;
@@ -122,25 +138,50 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
   else if (scheme == "bdf2") params.scheme = TimeScheme::BDF2;
   else if (scheme == "steady") params.scheme = TimeScheme::Steady;
   else section.fail("scheme", "must be bdf1, bdf2 or steady, got '" + scheme + "'");
+  // Steady Taylor-Hood problems default to Newton; P1/P1 has Picard (Oseen) iterations only.
+  std::string method = taylor_hood && params.scheme == TimeScheme::Steady ? "newton" : "picard";
   if (auto nl = section.optional_child("nonlinear")) {
     params.max_iterations = nl->get<int>("max_iterations", params.max_iterations);
     params.tolerance = nl->get<double>("tolerance", params.tolerance);
     if (params.max_iterations < 1) nl->fail("max_iterations", "must be at least 1");
+    method = nl->get<std::string>("method", method);
+    if (method != "picard" && method != "newton") nl->fail("method", "must be picard or newton, got '" + method + "'");
+    if (method == "newton" && !taylor_hood) nl->fail("method", "newton is available with fluid.element: p2p1");
   }
+  params.newton = method == "newton";
   if (params.scheme == TimeScheme::Steady && params.max_iterations == 1) params.max_iterations = 50;
+  if (taylor_hood) {
+    // Taylor-Hood is inf-sup stable: no PSPG; SUPG and grad-div only when asked for.
+    params.stabilisation.supg = false;
+    params.stabilisation.pspg = false;
+    params.stabilisation.lsic_scale = 0;
+  }
   if (auto st = section.optional_child("stabilisation")) {
     auto& s = params.stabilisation;
     s.supg = st->get<bool>("supg", s.supg);
-    s.pspg = st->get<bool>("pspg", s.pspg);
-    s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
     s.viscous_constant = st->get<double>("viscous_constant", s.viscous_constant);
     s.transient_tau = st->get<bool>("transient_tau", s.transient_tau);
-    s.viscous_residual = st->get<bool>("viscous_residual", s.viscous_residual);
+    if (taylor_hood) {
+      for (const char* key : {"pspg", "lsic_scale", "viscous_residual"})
+        if (st->has(key))
+          st->fail(key, "is a P1/P1 setting; the P2/P1 element takes supg, grad_div, viscous_constant, transient_tau");
+      s.grad_div = st->get<double>("grad_div", s.grad_div);
+      if (s.grad_div < 0) st->fail("grad_div", "must be >= 0");
+    } else {
+      if (st->has("grad_div")) st->fail("grad_div", "is a P2/P1 setting; the P1/P1 element takes lsic_scale");
+      s.pspg = st->get<bool>("pspg", s.pspg);
+      s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
+      s.viscous_residual = st->get<bool>("viscous_residual", s.viscous_residual);
+    }
   }
   params.threads = section.get<int>("threads", params.threads);
   params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
   if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
   if (auto ls = section.optional_child("linear_solver")) {
+    const auto ordering = ls->get<std::string>("ordering", "metis");
+    if (ordering == "metis") params.ordering = Ordering::Metis;
+    else if (ordering == "amd") params.ordering = Ordering::Amd;
+    else ls->fail("ordering", "must be metis or amd, got '" + ordering + "'");
     params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
     params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
     params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
@@ -168,7 +209,8 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
   }
 
-  solver_ = std::make_unique<NavierStokesSolver>(mesh, params);
+  if (taylor_hood) solver_ = std::make_unique<TaylorHoodSolver>(mesh, params);
+  else solver_ = std::make_unique<NavierStokesSolver>(mesh, params);
   auto& solver = *solver_;
   const auto& fluid_mesh = solver.mesh();
 
@@ -260,8 +302,11 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     if (method == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
     else if (method != "harmonic") iface.fail("mesh_motion", "must be 'harmonic' or 'elastic'");
     motion.incremental = iface.get<bool>("mesh_incremental", false);
-    motion_ = std::make_unique<MeshMotion>(fluid_mesh, solver.interface_nodes(), fluid_mesh.boundary_nodes(fixed_groups),
-                                           motion);
+    // P2 meshes: the extension runs on the 4-triangle refinement of every element, so
+    // midpoints move with it and curved interface edges follow the solid.
+    motion_mesh_ = fluid_mesh.linear_refinement();  // MeshMotion keeps a pointer to it
+    motion_ = std::make_unique<MeshMotion>(motion_mesh_, solver.interface_nodes(),
+                                           fluid_mesh.boundary_nodes(fixed_groups), motion);
   }
 
   // --- probes and output ---
@@ -291,8 +336,9 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
   if (auto out = section.optional_child("output")) vtk_every_ = out->get<int>("vtk_every", 0);
   if (vtk_every_ > 0 && !setup.output_dir.empty()) vtk_ = PvdSeries(setup.output_dir, "fluid");
 
-  log->info("fluid: {} nodes, {} triangles, {} unknowns, scheme {}, {} interface nodes, mesh {}", fluid_mesh.node_count(),
-            fluid_mesh.triangle_count(), solver.dofs(), scheme, solver.interface_nodes().size(), msh.string());
+  log->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, mesh {}", element,
+            taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(), fluid_mesh.triangle_count(), solver.dofs(),
+            scheme, method, solver.interface_nodes().size(), msh.string());
   start_ = last_log_ = std::chrono::steady_clock::now();
 }
 
@@ -337,6 +383,9 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   loads.velocity_integral = solver_->interface_velocity_integral();
   loads.nonlinear_iterations = last_report_.iterations;
   factorisations_ += last_report_.factorisations;
+  assembly_seconds_ += last_report_.assembly_seconds;
+  factor_seconds_ += last_report_.factor_seconds;
+  linear_solve_seconds_ += last_report_.solve_seconds;
   fsi::logger("fluid")->debug("step {} t={:.5g}: {} iteration(s), change {:.2e}, assembly {:.3f}s, {} factorisation(s) "
                               "{:.3f}s, {} BiCGSTAB iterations, solve {:.3f}s",
                               info.step, info.time, last_report_.iterations, last_report_.change,
@@ -382,7 +431,7 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
 
 std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {
   if (vtk_every_ <= 0 || setup_.output_dir.empty() || info.step % vtk_every_ != 0) return {};
-  const auto& mesh = solver_->mesh();
+  const auto mesh = solver_->mesh().linear_refinement();  // P2: 4 linear triangles per element
   VtkGrid grid;
   grid.points = solver_->positions();
   for (int e = 0; e < mesh.triangle_count(); ++e) {

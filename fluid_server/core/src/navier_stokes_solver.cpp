@@ -1,9 +1,7 @@
 #include "fsi/fluid/navier_stokes_solver.hpp"
 
 #include <Eigen/LU>
-#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
-#include <Eigen/UmfPackSupport>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -14,6 +12,7 @@
 #include <set>
 
 #include "fsi/common/solver_model.hpp"
+#include "fsi/fluid/sparse_lu.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -40,23 +39,6 @@ struct InterfaceSegment {
   int element;
   int local_a, local_b;  // local indices of the segment's nodes in the triangle
   int iface_a, iface_b;  // indices into interface_nodes
-};
-
-using LuSolver = Eigen::UmfPackLU<Eigen::SparseMatrix<double>>;
-
-// The factors of an earlier matrix used as a preconditioner (Eigen preconditioner concept).
-class FrozenLuPreconditioner {
- public:
-  FrozenLuPreconditioner() = default;
-  void set(const LuSolver* lu) { lu_ = lu; }
-  template <class M> FrozenLuPreconditioner& analyzePattern(const M&) { return *this; }
-  template <class M> FrozenLuPreconditioner& factorize(const M&) { return *this; }
-  template <class M> FrozenLuPreconditioner& compute(const M&) { return *this; }
-  template <class R> Eigen::VectorXd solve(const Eigen::MatrixBase<R>& b) const { return lu_->solve(b); }
-  Eigen::ComputationInfo info() const { return Eigen::Success; }
-
- private:
-  const LuSolver* lu_ = nullptr;
 };
 
 // div(mu grad u) per element (rows: triangles; constant in each), from the nodal gradients of
@@ -105,10 +87,7 @@ struct NavierStokesSolver::Impl {
   Eigen::SparseMatrix<double> matrix;       // system matrix (constraints applied)
   Eigen::SparseMatrix<double> volume;       // volume terms only (for reactions)
   std::vector<std::array<int, 9>> scatter;  // per element: 3*k offset of node a in adj(node b) -> index a*3+b
-  LuSolver lu;
-  bool analysed = false;
-  bool factorised = false;
-  bool stale = false;  // the factors precondition poorly: refactorise at the next solve
+  std::unique_ptr<SparseLu> lu;
   std::vector<DirichletCondition> dirichlet;
   std::vector<SymmetryCondition> symmetry;
   std::vector<InterfaceSegment> segments;
@@ -121,6 +100,10 @@ struct NavierStokesSolver::Impl {
 
 NavierStokesSolver::NavierStokesSolver(FluidMesh mesh, FlowParameters params)
     : mesh_(std::move(mesh)), params_(params), impl_(std::make_unique<Impl>()) {
+  if (mesh_.quadratic())
+    throw std::invalid_argument("the P1/P1 fluid needs a mesh of 3-node triangles (this one has 6-node triangles: "
+                                "use fluid.element: p2p1, or mesh with -order 1)");
+  impl_->lu = std::make_unique<SparseLu>(params_);
   const int n = mesh_.node_count();
   auto& adj = impl_->adjacency;
   adj.assign(static_cast<std::size_t>(n), {});
@@ -439,45 +422,8 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
       if (constrained[static_cast<std::size_t>(d)]) rhs(d) = constraint_value(d);
     report.assembly_seconds += seconds_since(t_assembly);
 
-    Eigen::VectorXd U_new;
-    bool solved = false;
-    if (params_.reuse_factorisation && impl_->factorised && !impl_->stale) {
-      const auto t_solve = Clock::now();
-      Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, FrozenLuPreconditioner> krylov;
-      krylov.preconditioner().set(&impl_->lu);
-      krylov.setTolerance(params_.krylov_tolerance);
-      krylov.setMaxIterations(params_.krylov_max_iterations);
-      krylov.compute(A);
-      U_new = krylov.solveWithGuess(rhs, U_adv);
-      report.solve_seconds += seconds_since(t_solve);
-      if (krylov.info() == Eigen::Success && U_new.allFinite()) {
-        solved = true;
-        report.krylov_iterations += static_cast<int>(krylov.iterations());
-        if (krylov.iterations() > params_.krylov_refactor_iterations) impl_->stale = true;
-      }
-    }
-    if (!solved) {
-      const auto t_factor = Clock::now();
-      if (!impl_->analysed) {
-        impl_->lu.umfpackControl()(UMFPACK_IRSTEP) = params_.umfpack_irstep;
-        impl_->lu.analyzePattern(A);
-        impl_->analysed = true;
-      }
-      impl_->lu.factorize(A);
-      if (impl_->lu.info() != Eigen::Success)
-        throw SolverError(fmt::format("fluid step at t = {:.6g}, iteration {}: UMFPACK factorisation failed (singular "
-                                      "matrix?: check that the pressure is fixed by an outlet or a pressure reference)",
-                                      time, iteration));
-      impl_->factorised = true;
-      impl_->stale = false;
-      ++report.factorisations;
-      report.factor_seconds += seconds_since(t_factor);
-      const auto t_solve = Clock::now();
-      U_new = impl_->lu.solve(rhs);
-      report.solve_seconds += seconds_since(t_solve);
-    }
-    if (!U_new.allFinite())
-      throw SolverError(fmt::format("fluid step at t = {:.6g}, iteration {}: the solution is not finite", time, iteration));
+    const Eigen::VectorXd U_new =
+        impl_->lu->solve(A, rhs, U_adv, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration));
 
     double diff = 0, norm = 0;
     for (int i = 0; i < n; ++i)

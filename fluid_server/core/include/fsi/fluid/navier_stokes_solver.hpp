@@ -22,44 +22,12 @@
 #include <vector>
 
 #include "fsi/fluid/mesh.hpp"
+#include "fsi/fluid/flow_solver.hpp"
 #include "fsi/fluid/p1_element.hpp"
 
 namespace fsi::fluid {
 
-using VelocityFunction = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
-
-enum class TimeScheme { Steady, BDF1, BDF2 };
-
-struct FlowParameters {
-  double density = 1.0;
-  double viscosity = 1e-3;  // dynamic
-  TimeScheme scheme = TimeScheme::BDF2;
-  int max_iterations = 1;   // Picard solves per step
-  double tolerance = 1e-10; // stop when the relative velocity change falls below
-  StabilisationParameters stabilisation;
-  double nitsche_penalty = 0;    // gamma_N1
-  double nitsche_symmetry = -1;  // gamma_N2 (+1 symmetric, -1 unsymmetric)
-  int threads = 1;
-  int umfpack_irstep = 0;
-  // Reuse the last LU factors as the preconditioner of BiCGSTAB on the new matrix; refactorise
-  // only when BiCGSTAB needs more than krylov_max_iterations (or on the first solve).
-  bool reuse_factorisation = true;
-  double krylov_tolerance = 1e-10;  // relative residual
-  int krylov_max_iterations = 25;
-  int krylov_refactor_iterations = 8;  // a solve needing more marks the factors stale: refactorise next time
-};
-
-struct StepReport {
-  int iterations = 0;
-  double change = 0;           // last relative velocity change
-  double assembly_seconds = 0;
-  double factor_seconds = 0;
-  double solve_seconds = 0;
-  int factorisations = 0;
-  int krylov_iterations = 0;
-};
-
-class NavierStokesSolver {
+class NavierStokesSolver : public FlowSolver {
  public:
   NavierStokesSolver(FluidMesh mesh, FlowParameters params);
   ~NavierStokesSolver();
@@ -67,42 +35,42 @@ class NavierStokesSolver {
   NavierStokesSolver& operator=(NavierStokesSolver&&) noexcept;
 
   // --- set-up (before the first solve) ---
-  void add_dirichlet(const std::string& group, VelocityFunction velocity);  // strong, both components
-  void add_symmetry(const std::string& group);                              // u.n = 0 (axis-aligned groups)
-  void set_interface(const std::vector<std::string>& groups);               // Nitsche groups
-  void set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value);
-  void set_body_force(VelocityFunction force);
+  void add_dirichlet(const std::string& group, VelocityFunction velocity) override;  // strong, both components
+  void add_symmetry(const std::string& group) override;                              // u.n = 0 (axis-aligned groups)
+  void set_interface(const std::vector<std::string>& groups) override;               // Nitsche groups
+  void set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value) override;
+  void set_body_force(VelocityFunction force) override;
   void set_initial_velocity(const Eigen::MatrixX2d& velocity);
 
   // --- stepping ---
   // Solves time level `time` (= t_n + dt) from the accepted state, on the mesh at `positions`
   // (n x 2, current configuration), with the interface velocity per interface node
   // (interleaved, 2 * interface_nodes().size(); empty = zero). Repeatable before accept().
-  StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity);
-  void accept();
+  StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity) override;
+  void accept() override;
 
   // --- results of the last solve ---
-  const FluidMesh& mesh() const { return mesh_; }
-  const FlowParameters& parameters() const { return params_; }
-  int dofs() const { return 3 * mesh_.node_count(); }
+  const FluidMesh& mesh() const override { return mesh_; }
+  const FlowParameters& parameters() const override { return params_; }
+  int dofs() const override { return 3 * mesh_.node_count(); }
   const Eigen::VectorXd& solution() const { return U_; }  // (u, v, p) per node
-  Eigen::MatrixX2d velocity() const;
-  Eigen::VectorXd pressure() const;
-  const Eigen::MatrixX2d& positions() const { return X_; }
+  Eigen::MatrixX2d velocity() const override;
+  Eigen::VectorXd pressure() const override;
+  const Eigen::MatrixX2d& positions() const override { return X_; }
   const Eigen::MatrixX2d& accepted_positions() const { return X_n_; }
   // Force of the fluid on the body bounded by the groups: -sum of the momentum reactions
   // (residual of the volume terms) over the groups' nodes.
-  Eigen::Vector2d force(const std::vector<std::string>& groups) const;
+  Eigen::Vector2d force(const std::vector<std::string>& groups) const override;
   const Eigen::VectorXd& reaction() const { return reaction_; }  // K_vol U - F_vol, 3 per node
   // Interface (Nitsche) groups.
-  const std::vector<int>& interface_nodes() const { return interface_nodes_; }
-  const IndexMatrix2& interface_segments() const { return interface_segments_; }  // local indices
+  const std::vector<int>& interface_nodes() const override { return interface_nodes_; }
+  const IndexMatrix2& interface_segments() const override { return interface_segments_; }  // local indices
   // f_sigma = int N^T sigma n (n = fluid outward normal), from the reaction plus the penalty
   // term: reaction + gamma_N1 int N^T (v_f - v_s); f_v = int N^T v_f. Current configuration.
-  Eigen::VectorXd interface_traction() const;
-  Eigen::VectorXd interface_velocity_integral() const;
-  double pressure_at(const Eigen::Vector2d& point) const;  // NaN outside the mesh
-  Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const;
+  Eigen::VectorXd interface_traction() const override;
+  Eigen::VectorXd interface_velocity_integral() const override;
+  double pressure_at(const Eigen::Vector2d& point) const override;  // NaN outside the mesh
+  Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const override;
 
  private:
   struct Impl;

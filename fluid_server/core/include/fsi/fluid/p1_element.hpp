@@ -15,16 +15,9 @@
 // consistency of SUPG/PSPG in boundary layers (explicit in u*, so the matrix is unchanged).
 #include <Eigen/Core>
 
-namespace fsi::fluid {
+#include "fsi/fluid/flow_solver.hpp"  // StabilisationParameters
 
-struct StabilisationParameters {
-  bool supg = true;
-  bool pspg = true;
-  double lsic_scale = 1.0;        // multiplies tau_C = h^2 / (8 tau_M); 0 switches LSIC off
-  double viscous_constant = 3.0;  // c in tau_M^-2 = (2/dt)^2 + (2|a|/h)^2 + (c 4 nu/h^2)^2
-  bool transient_tau = true;      // include the (2/dt)^2 term
-  bool viscous_residual = false;  // include the reconstructed div(mu grad u*) in r_M (ElementInput::viscous)
-};
+namespace fsi::fluid {
 
 struct ElementInput {
   Eigen::Matrix<double, 3, 2> x;        // node positions (current configuration)

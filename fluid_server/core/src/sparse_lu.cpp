@@ -1,0 +1,91 @@
+#include "fsi/fluid/sparse_lu.hpp"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/UmfPackSupport>
+#include <fmt/format.h>
+
+#include <chrono>
+
+#include "fsi/common/solver_model.hpp"
+
+namespace fsi::fluid {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+using LuSolver = Eigen::UmfPackLU<Eigen::SparseMatrix<double>>;
+
+// The factors of an earlier matrix used as a preconditioner (Eigen preconditioner concept).
+class FrozenLuPreconditioner {
+ public:
+  FrozenLuPreconditioner() = default;
+  void set(const LuSolver* lu) { lu_ = lu; }
+  template <class M> FrozenLuPreconditioner& analyzePattern(const M&) { return *this; }
+  template <class M> FrozenLuPreconditioner& factorize(const M&) { return *this; }
+  template <class M> FrozenLuPreconditioner& compute(const M&) { return *this; }
+  template <class R> Eigen::VectorXd solve(const Eigen::MatrixBase<R>& b) const { return lu_->solve(b); }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+
+ private:
+  const LuSolver* lu_ = nullptr;
+};
+
+}  // namespace
+
+struct SparseLu::Impl {
+  FlowParameters params;
+  LuSolver lu;
+  bool analysed = false;
+  bool factorised = false;
+  bool stale = false;  // the factors precondition poorly: refactorise at the next solve
+};
+
+SparseLu::SparseLu(const FlowParameters& params) : impl_(std::make_unique<Impl>()) { impl_->params = params; }
+SparseLu::~SparseLu() = default;
+SparseLu::SparseLu(SparseLu&&) noexcept = default;
+SparseLu& SparseLu::operator=(SparseLu&&) noexcept = default;
+
+Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, const Eigen::VectorXd& guess,
+                                StepReport& report, const std::string& where) {
+  auto& s = *impl_;
+  const auto& p = s.params;
+  Eigen::VectorXd x;
+  if (p.reuse_factorisation && s.factorised && !s.stale) {
+    const auto t_solve = Clock::now();
+    Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, FrozenLuPreconditioner> krylov;
+    krylov.preconditioner().set(&s.lu);
+    krylov.setTolerance(p.krylov_tolerance);
+    krylov.setMaxIterations(p.krylov_max_iterations);
+    krylov.compute(A);
+    x = guess.size() == b.size() ? Eigen::VectorXd(krylov.solveWithGuess(b, guess)) : Eigen::VectorXd(krylov.solve(b));
+    report.solve_seconds += seconds_since(t_solve);
+    if (krylov.info() == Eigen::Success && x.allFinite()) {
+      report.krylov_iterations += static_cast<int>(krylov.iterations());
+      if (krylov.iterations() > p.krylov_refactor_iterations) s.stale = true;
+      return x;
+    }
+  }
+  const auto t_factor = Clock::now();
+  if (!s.analysed) {
+    s.lu.umfpackControl()(UMFPACK_IRSTEP) = p.umfpack_irstep;
+    s.lu.umfpackControl()(UMFPACK_ORDERING) = p.ordering == Ordering::Metis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
+    s.lu.analyzePattern(A);
+    s.analysed = true;
+  }
+  s.lu.factorize(A);
+  if (s.lu.info() != Eigen::Success)
+    throw SolverError(fmt::format("{}: UMFPACK factorisation failed (singular matrix?: check that the pressure is fixed "
+                                  "by an outlet or a pressure reference)",
+                                  where));
+  s.factorised = true;
+  s.stale = false;
+  ++report.factorisations;
+  report.factor_seconds += seconds_since(t_factor);
+  const auto t_solve = Clock::now();
+  x = s.lu.solve(b);
+  report.solve_seconds += seconds_since(t_solve);
+  if (!x.allFinite()) throw SolverError(fmt::format("{}: the solution is not finite", where));
+  return x;
+}
+
+}  // namespace fsi::fluid
