@@ -183,4 +183,109 @@ TEST(TaylorHood, KovasznayOnAMovingMeshKeepsTheSpatialRates) {
   EXPECT_GT(rate_p, 1.7);
 }
 
+// Nitsche interface with P2 traces: a rotating cylinder in the DFG channel (isoparametric
+// mesh), its wall velocity imposed strongly and through Nitsche with gamma_N2 = +1 / -1.
+const Eigen::Vector2d kCentre(0.2, 0.2);
+constexpr double kOmega = 4.0;  // rad/s: wall speed 0.2, comparable to U_bar
+
+Eigen::Vector2d rotation(const Eigen::Vector2d& x) {
+  const Eigen::Vector2d r = x - kCentre;
+  return kOmega * Eigen::Vector2d(-r.y(), r.x());
+}
+
+TaylorHoodSolver rotating_cylinder(const FluidMesh& mesh, bool nitsche, double penalty, double symmetry) {
+  FlowParameters p;
+  p.density = 1;
+  p.viscosity = 1e-3;
+  p.scheme = TimeScheme::Steady;
+  p.newton = true;
+  p.max_iterations = 30;
+  p.tolerance = 1e-10;
+  p.nitsche_penalty = penalty;
+  p.nitsche_symmetry = symmetry;
+  p.stabilisation.supg = false;
+  TaylorHoodSolver s(mesh, p);
+  s.add_dirichlet("inlet", [](const Eigen::Vector2d& x, double) {
+    return Eigen::Vector2d(4 * 0.3 * x.y() * (0.41 - x.y()) / (0.41 * 0.41), 0);
+  });
+  s.add_dirichlet("walls", [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
+  if (nitsche) s.set_interface({"cylinder"});
+  else s.add_dirichlet("cylinder", [](const Eigen::Vector2d& x, double) { return rotation(x); });
+  return s;
+}
+
+TEST(TaylorHood, NitscheRotatingCylinderMatchesStrongDirichletForBothSymmetries) {
+  const auto msh = mesh_geo(FSI_FLUID_SOURCE_DIR "/configs/meshes/dfg_cylinder.geo", {{"h", 0.06}, {"hc", 0.008}},
+                            std::filesystem::temp_directory_path() / "fsi_fluid_test_meshes", 2);
+  const auto mesh = FluidMesh::from_gmsh(fsi::read_gmsh(msh));
+  ASSERT_TRUE(mesh.quadratic());
+  // Isoparametric: every cylinder midpoint lies on the circle (gmsh -order 2).
+  const auto& mids = mesh.boundary_midpoints.at("cylinder");
+  for (Eigen::Index i = 0; i < mids.size(); ++i)
+    ASSERT_NEAR((mesh.nodes.row(mids(i)).transpose() - kCentre).norm(), 0.05, 1e-9);
+  auto strong = rotating_cylinder(mesh, false, 0, -1);
+  ASSERT_LT(strong.solve(1, 1, mesh.nodes, {}).change, 1e-9);
+  const Eigen::Vector2d f_strong = strong.force({"cylinder"});
+  const double scale = 2 / (0.2 * 0.2 * 0.1);
+  std::printf("P2/P1 strong:   C_D %.5f  C_L %.5f\n", scale * f_strong.x(), scale * f_strong.y());
+  EXPECT_GT(std::abs(f_strong.y()), 0.05 * f_strong.x()) << "rotation should produce a clear Magnus lift";
+  for (double symmetry : {+1.0, -1.0}) {
+    auto weak = rotating_cylinder(mesh, true, 100.0, symmetry);
+    Eigen::VectorXd vs(2 * static_cast<Eigen::Index>(weak.interface_nodes().size()));
+    for (std::size_t i = 0; i < weak.interface_nodes().size(); ++i)
+      vs.segment<2>(2 * static_cast<Eigen::Index>(i)) = rotation(mesh.nodes.row(weak.interface_nodes()[i]).transpose());
+    ASSERT_LT(weak.solve(1, 1, mesh.nodes, vs).change, 1e-9);
+    const Eigen::Vector2d f = weak.force({"cylinder"});
+    // F* = f_sigma - gamma_N1 (f_v - int N^T v_s) is the consistent reaction: its sum is minus the force.
+    const Eigen::VectorXd fs = weak.interface_traction();
+    Eigen::Vector2d total_sigma = Eigen::Vector2d::Zero();
+    for (Eigen::Index i = 0; i < fs.size() / 2; ++i) total_sigma += fs.segment<2>(2 * i);
+    std::printf("P2/P1 gamma_N2 %+g gamma_N1 100: C_D %.5f  C_L %.5f (sum of f_sigma: %.5f %.5f)\n", symmetry,
+                scale * f.x(), scale * f.y(), -scale * total_sigma.x(), -scale * total_sigma.y());
+    EXPECT_NEAR(f.x(), f_strong.x(), 0.005 * f_strong.x()) << "gamma_N2 " << symmetry;
+    EXPECT_NEAR(f.y(), f_strong.y(), 0.02 * std::abs(f_strong.y())) << "gamma_N2 " << symmetry;
+    EXPECT_NEAR(-total_sigma.x(), f.x(), 0.02 * f.x());
+    // The interface nodes are the vertices and the midpoints of the cylinder edges.
+    EXPECT_EQ(weak.interface_nodes().size(), 2 * mesh.boundary("cylinder").rows());
+    EXPECT_EQ(weak.interface_segments().rows(), 2 * mesh.boundary("cylinder").rows());
+  }
+}
+
+TEST(TaylorHood, SolidBodyTranslationThroughNitscheIsExact) {
+  // Every wall of a box moves with the same velocity (Nitsche on all sides, pressure pinned):
+  // u = const, p = 0 is reproduced to round-off for both gamma_N2.
+  const auto mesh = FluidMesh::rectangle(0, 1, 0, 1, 6, 6);
+  for (double symmetry : {+1.0, -1.0}) {
+    FlowParameters p;
+    p.viscosity = 0.01;
+    p.scheme = TimeScheme::BDF1;
+    p.nitsche_penalty = 10;
+    p.nitsche_symmetry = symmetry;
+    p.stabilisation.supg = false;
+    TaylorHoodSolver s(mesh, p);
+    s.set_interface({"left", "right", "bottom", "top"});
+    s.set_pressure_reference({0.5, 0.5}, [](double) { return 0.0; });
+    Eigen::MatrixX2d initial(s.mesh().node_count(), 2);
+    initial.col(0).setConstant(0.3);
+    initial.col(1).setConstant(-0.2);
+    s.set_initial_velocity(initial);
+    Eigen::VectorXd vs(2 * static_cast<Eigen::Index>(s.interface_nodes().size()));
+    for (Eigen::Index i = 0; i < vs.size() / 2; ++i) vs.segment<2>(2 * i) << 0.3, -0.2;
+    s.solve(0.1, 0.1, s.mesh().nodes, vs);
+    const auto v = s.velocity();
+    EXPECT_NEAR((v.col(0).array() - 0.3).abs().maxCoeff(), 0.0, 1e-10);
+    EXPECT_NEAR((v.col(1).array() + 0.2).abs().maxCoeff(), 0.0, 1e-10);
+    EXPECT_NEAR(s.pressure().cwiseAbs().maxCoeff(), 0.0, 1e-10);
+    // f_v = int N^T v_f sums to v times the perimeter (4).
+    const Eigen::VectorXd fv = s.interface_velocity_integral();
+    double sx = 0, sy = 0;
+    for (Eigen::Index i = 0; i < fv.size() / 2; ++i) {
+      sx += fv(2 * i);
+      sy += fv(2 * i + 1);
+    }
+    EXPECT_NEAR(sx, 0.3 * 4, 1e-12);
+    EXPECT_NEAR(sy, -0.2 * 4, 1e-12);
+  }
+}
+
 }  // namespace

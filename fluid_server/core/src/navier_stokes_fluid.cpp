@@ -177,11 +177,18 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
   params.threads = section.get<int>("threads", params.threads);
   params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
   if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
+  if (taylor_hood) params.strategy = LuStrategy::Symmetric;
   if (auto ls = section.optional_child("linear_solver")) {
-    const auto ordering = ls->get<std::string>("ordering", "metis");
+    const auto ordering = ls->get<std::string>("ordering", "auto");
     if (ordering == "metis") params.ordering = Ordering::Metis;
     else if (ordering == "amd") params.ordering = Ordering::Amd;
-    else ls->fail("ordering", "must be metis or amd, got '" + ordering + "'");
+    else if (ordering == "auto") params.ordering = Ordering::Auto;
+    else ls->fail("ordering", "must be auto, metis or amd, got '" + ordering + "'");
+    const auto strategy = ls->get<std::string>("strategy", taylor_hood ? "symmetric" : "auto");
+    if (strategy == "symmetric") params.strategy = LuStrategy::Symmetric;
+    else if (strategy == "unsymmetric") params.strategy = LuStrategy::Unsymmetric;
+    else if (strategy == "auto") params.strategy = LuStrategy::Auto;
+    else ls->fail("strategy", "must be auto, symmetric or unsymmetric, got '" + strategy + "'");
     params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
     params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
     params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);

@@ -6,6 +6,7 @@
 
 #include <chrono>
 
+#include "fsi/common/log.hpp"
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi::fluid {
@@ -34,10 +35,12 @@ class FrozenLuPreconditioner {
 
 struct SparseLu::Impl {
   FlowParameters params;
-  LuSolver lu;
+  std::unique_ptr<LuSolver> lu = std::make_unique<LuSolver>();
   bool analysed = false;
   bool factorised = false;
   bool stale = false;  // the factors precondition poorly: refactorise at the next solve
+  Ordering chosen = Ordering::Amd;
+  std::pair<double, double> measured{0, 0};  // auto: factorisation seconds with AMD, METIS
 };
 
 SparseLu::SparseLu(const FlowParameters& params) : impl_(std::make_unique<Impl>()) { impl_->params = params; }
@@ -53,7 +56,7 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
   if (p.reuse_factorisation && s.factorised && !s.stale) {
     const auto t_solve = Clock::now();
     Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, FrozenLuPreconditioner> krylov;
-    krylov.preconditioner().set(&s.lu);
+    krylov.preconditioner().set(s.lu.get());
     krylov.setTolerance(p.krylov_tolerance);
     krylov.setMaxIterations(p.krylov_max_iterations);
     krylov.compute(A);
@@ -67,13 +70,42 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
   }
   const auto t_factor = Clock::now();
   if (!s.analysed) {
-    s.lu.umfpackControl()(UMFPACK_IRSTEP) = p.umfpack_irstep;
-    s.lu.umfpackControl()(UMFPACK_ORDERING) = p.ordering == Ordering::Metis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
-    s.lu.analyzePattern(A);
+    auto analyse = [&](LuSolver& lu, Ordering ordering) {
+      lu.umfpackControl()(UMFPACK_IRSTEP) = p.umfpack_irstep;
+      lu.umfpackControl()(UMFPACK_ORDERING) = ordering == Ordering::Metis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
+      lu.umfpackControl()(UMFPACK_STRATEGY) = p.strategy == LuStrategy::Symmetric     ? UMFPACK_STRATEGY_SYMMETRIC
+                                              : p.strategy == LuStrategy::Unsymmetric ? UMFPACK_STRATEGY_UNSYMMETRIC
+                                                                                      : UMFPACK_STRATEGY_AUTO;
+      lu.analyzePattern(A);
+    };
+    if (p.ordering == Ordering::Auto) {
+      // Measure both orderings on the first matrix (analysis + factorisation) and keep the
+      // one whose factorisation is faster: every later factorisation reuses its analysis.
+      auto other = std::make_unique<LuSolver>();
+      analyse(*s.lu, Ordering::Amd);
+      const auto t_amd = Clock::now();
+      s.lu->factorize(A);
+      const double amd = seconds_since(t_amd);
+      analyse(*other, Ordering::Metis);
+      const auto t_metis = Clock::now();
+      other->factorize(A);
+      const double metis = seconds_since(t_metis);
+      s.chosen = metis < amd ? Ordering::Metis : Ordering::Amd;
+      s.measured = {amd, metis};
+      if (s.chosen == Ordering::Metis) std::swap(s.lu, other);
+      fsi::logger("fluid")->info("linear solver: ordering auto chose {} (first factorisation of {} unknowns: AMD {:.3f} s, "
+                                 "METIS {:.3f} s)",
+                                 s.chosen == Ordering::Metis ? "METIS" : "AMD", A.rows(), amd, metis);
+    } else {
+      analyse(*s.lu, p.ordering);
+      s.chosen = p.ordering;
+    }
     s.analysed = true;
+    if (p.ordering != Ordering::Auto) s.lu->factorize(A);
+  } else {
+    s.lu->factorize(A);
   }
-  s.lu.factorize(A);
-  if (s.lu.info() != Eigen::Success)
+  if (s.lu->info() != Eigen::Success)
     throw SolverError(fmt::format("{}: UMFPACK factorisation failed (singular matrix?: check that the pressure is fixed "
                                   "by an outlet or a pressure reference)",
                                   where));
@@ -82,10 +114,15 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
   ++report.factorisations;
   report.factor_seconds += seconds_since(t_factor);
   const auto t_solve = Clock::now();
-  x = s.lu.solve(b);
+  x = s.lu->solve(b);
   report.solve_seconds += seconds_since(t_solve);
   if (!x.allFinite()) throw SolverError(fmt::format("{}: the solution is not finite", where));
   return x;
 }
 
+}  // namespace fsi::fluid
+
+namespace fsi::fluid {
+Ordering SparseLu::ordering() const { return impl_->chosen; }
+std::pair<double, double> SparseLu::measured_orderings() const { return impl_->measured; }
 }  // namespace fsi::fluid

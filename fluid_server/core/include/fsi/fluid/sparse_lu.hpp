@@ -1,6 +1,7 @@
 #pragma once
 // The fluid's linear solve, shared by both discretisations: UMFPACK with one symbolic
 // analysis per sparsity pattern (METIS or AMD ordering), a numeric factorisation per matrix,
+// (ordering auto: both tried on the first matrix, the faster kept),
 // or - with reuse_factorisation - BiCGSTAB preconditioned by the factors of an earlier
 // matrix, refactorising only when that preconditioner has gone stale.
 //
@@ -11,6 +12,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "fsi/fluid/flow_solver.hpp"
 
@@ -26,6 +28,10 @@ class SparseLu {
   // (prefixed with `where`) when the matrix is singular or the solution not finite.
   Eigen::VectorXd solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, const Eigen::VectorXd& guess,
                         StepReport& report, const std::string& where);
+  // The ordering in use (Ordering::Auto picks it at the first factorisation) and, for Auto,
+  // the measured factorisation seconds with AMD and with METIS (0, 0 otherwise).
+  Ordering ordering() const;
+  std::pair<double, double> measured_orderings() const;
 
  private:
   struct Impl;
