@@ -3,10 +3,12 @@
 //   h       element size far from the cylinder
 //   hc      element size on the cylinder (default h / 5)
 //   hw      element size in the near wake x < 0.8 (default h / 2)
+//   algorithm  gmsh 2D algorithm (default 6; 5 gives another layout of the same sizes)
 // Physical groups: inlet (x = 0), outlet (x = 2.2), walls (y = 0, 0.41), cylinder, fluid.
 DefineConstant[ h = 0.04 ];
 DefineConstant[ hc = h / 5 ];
 DefineConstant[ hw = h / 2 ];
+DefineConstant[ algorithm = 6 ];
 L = 2.2; H = 0.41; xc = 0.2; yc = 0.2; r = 0.05;
 
 Point(1) = {0, 0, 0, h};
@@ -56,7 +58,7 @@ Background Field = 4;
 Mesh.MeshSizeExtendFromBoundary = 0;
 Mesh.MeshSizeFromPoints = 0;
 Mesh.MeshSizeFromCurvature = 0;
-Mesh.Algorithm = 6;
+Mesh.Algorithm = algorithm;       // 6 frontal-Delaunay (default), 5 Delaunay, 1 MeshAdapt: another layout of the same sizes
 
 Physical Curve("inlet") = {4};
 Physical Curve("outlet") = {2};

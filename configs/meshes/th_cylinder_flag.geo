@@ -5,11 +5,13 @@
 //   h    element size far from the body
 //   hc   element size on the cylinder and the flag (default h / 5)
 //   hw   element size in the near wake x < 1.2 (default h / 2)
+//   algorithm  gmsh 2D algorithm (default 6; 5 gives another layout of the same sizes)
 // Physical groups: inlet (x = 0), outlet (x = 2.5), walls (y = 0, 0.41), cylinder, flag, fluid.
 SetFactory("OpenCASCADE");
 DefineConstant[ h = 0.04 ];
 DefineConstant[ hc = h / 5 ];
 DefineConstant[ hw = h / 2 ];
+DefineConstant[ algorithm = 6 ];
 L = 2.5; H = 0.41; xc = 0.2; yc = 0.2; r = 0.05;
 eps = 1e-6;
 
@@ -51,7 +53,7 @@ Background Field = 4;
 Mesh.MeshSizeExtendFromBoundary = 0;
 Mesh.MeshSizeFromPoints = 0;
 Mesh.MeshSizeFromCurvature = 0;
-Mesh.Algorithm = 6;
+Mesh.Algorithm = algorithm;       // 6 frontal-Delaunay (default), 5 Delaunay, 1 MeshAdapt: another layout of the same sizes
 
 Physical Curve("inlet") = {inlet()};
 Physical Curve("outlet") = {outlet()};

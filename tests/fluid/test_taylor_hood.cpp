@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "fsi/common/gmsh_reader.hpp"
+#include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/navier_stokes_fluid.hpp"
 #include "fsi/fluid/p2p1_element.hpp"
 #include "fsi/fluid/taylor_hood_solver.hpp"
@@ -286,6 +287,53 @@ TEST(TaylorHood, SolidBodyTranslationThroughNitscheIsExact) {
     EXPECT_NEAR(sx, 0.3 * 4, 1e-12);
     EXPECT_NEAR(sy, -0.2 * 4, 1e-12);
   }
+}
+
+TEST(TaylorHood, BadlyCurvedElementIsReportedWithTimeAndPlace) {
+  TaylorHoodSolver s(FluidMesh::rectangle(0, 1, 0, 1, 4, 4), FlowParameters{});
+  s.add_dirichlet("bottom", [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
+  Eigen::MatrixX2d x = s.mesh().nodes;
+  // Push the midpoint of element 5's first edge far past the opposite vertex: the quadratic
+  // map folds (det J < 0 inside) although the vertices are untouched.
+  const int mid = s.mesh().edge_nodes(5, 0);
+  const int opposite = s.mesh().triangles(5, 2);
+  x.row(mid) += 2.0 * (x.row(opposite) - x.row(mid));
+  try {
+    s.solve(0.25, 0.25, x, {});
+    FAIL() << "expected a SolverError";
+  } catch (const fsi::SolverError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("t = 0.25"), std::string::npos) << what;
+    EXPECT_NE(what.find("curved"), std::string::npos) << what;
+    EXPECT_NE(what.find("near ("), std::string::npos) << what;
+  }
+}
+
+TEST(FluidMesh, QuadraticMeshHelpersAreConsistent) {
+  const auto linear = FluidMesh::rectangle(0, 2, 0, 1, 4, 2);
+  const auto quad = linear.quadratic_from_linear();
+  ASSERT_TRUE(quad.quadratic());
+  EXPECT_EQ(quad.vertices(), linear.node_count());
+  // Euler: edges = vertices + triangles - 1 for a disc; one midpoint per edge.
+  EXPECT_EQ(quad.node_count(), linear.node_count() + (linear.node_count() + linear.triangle_count() - 1));
+  for (int e = 0; e < quad.triangle_count(); ++e)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::RowVector2d m = 0.5 * (quad.nodes.row(quad.triangles(e, k)) + quad.nodes.row(quad.triangles(e, (k + 1) % 3)));
+      EXPECT_NEAR((quad.nodes.row(quad.edge_nodes(e, k)) - m).norm(), 0.0, 1e-15);
+    }
+  EXPECT_EQ(quad.boundary_nodes({"bottom"}).size(), 9u);  // 5 vertices + 4 midpoints
+  const auto refined = quad.linear_refinement();
+  EXPECT_EQ(refined.triangle_count(), 4 * quad.triangle_count());
+  EXPECT_EQ(refined.boundary("bottom").rows(), 8);
+  double area = 0;
+  for (int e = 0; e < refined.triangle_count(); ++e) {
+    Eigen::Matrix<double, 3, 2> x;
+    for (int k = 0; k < 3; ++k) x.row(k) = refined.nodes.row(refined.triangles(e, k));
+    const double a = 0.5 * ((x(1, 0) - x(0, 0)) * (x(2, 1) - x(0, 1)) - (x(1, 1) - x(0, 1)) * (x(2, 0) - x(0, 0)));
+    EXPECT_GT(a, 0.0);
+    area += a;
+  }
+  EXPECT_NEAR(area, 2.0, 1e-12);
 }
 
 }  // namespace

@@ -311,11 +311,14 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
       in.viscosity = params_.viscosity;
       in.alpha0_dt = steady ? 0.0 : alpha0 / dt;
       in.dt = steady ? 0.0 : dt;
+      in.newton = params_.newton;
 #pragma omp for schedule(static)
       for (int e = 0; e < mesh_.triangle_count(); ++e) {
         for (int k = 0; k < 3; ++k) {
           const int node = mesh_.triangles(e, k);
           in.x.row(k) = X_.row(node);
+          in.velocity(k, 0) = U_adv(3 * node);
+          in.velocity(k, 1) = U_adv(3 * node + 1);
           in.advection(k, 0) = U_adv(3 * node) - mesh_velocity(node, 0);
           in.advection(k, 1) = U_adv(3 * node + 1) - mesh_velocity(node, 1);
           in.history(k, 0) = history(3 * node);

@@ -50,6 +50,8 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
   // Three-point rule (exact for quadratics): barycentric (2/3, 1/6, 1/6) and permutations.
   static const double kN[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
   const double w = area / 3.0;
+  // Newton: the Galerkin convection's derivative (du . grad) u_k, grad u_k constant in P1.
+  const Eigen::Matrix2d Gu = in.newton ? Eigen::Matrix2d(in.velocity.transpose() * dN) : Eigen::Matrix2d::Zero();
   for (int q = 0; q < 3; ++q) {
     const Eigen::Vector3d N(kN[q][0], kN[q][1], kN[q][2]);
     const Eigen::RowVector2d a = N.transpose() * in.advection;
@@ -64,6 +66,10 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
       for (int c = 0; c < 2; ++c) {
         out.rhs(3 * i + c) += w * (N(i) * src(c) + tau_supg * adv(i) * src_stab(c));
       }
+      if (in.newton) {
+        const Eigen::RowVector2d uk = N.transpose() * in.velocity;
+        for (int c = 0; c < 2; ++c) out.rhs(3 * i + c) += w * N(i) * rho * uk.dot(Gu.row(c));  // (w, rho (u_k . grad) u_k)
+      }
       out.rhs(3 * i + 2) += w * (tau_pspg / rho) * dN.row(i).dot(src_stab);
       for (int j = 0; j < 3; ++j) {
         const double transport = rho * (in.alpha0_dt * N(j) + adv(j));  // rho(alpha0/dt N_j + a.grad N_j)
@@ -76,6 +82,9 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
           out.matrix(3 * i + 2, 3 * j + c) += w * (N(i) * dN(j, c) + (tau_pspg / rho) * dN(i, c) * transport);
         }
         out.matrix(3 * i + 2, 3 * j + 2) += w * (tau_pspg / rho) * dN.row(i).dot(dN.row(j));
+        if (in.newton)
+          for (int c = 0; c < 2; ++c)
+            for (int d = 0; d < 2; ++d) out.matrix(3 * i + c, 3 * j + d) += w * rho * N(i) * N(j) * Gu(c, d);
       }
     }
   }

@@ -24,6 +24,8 @@ struct ElementInput {
   Eigen::Matrix<double, 3, 2> advection;  // a = u* - w at the nodes
   Eigen::Matrix<double, 3, 2> history;    // (alpha1 u_n + alpha2 u_{n-1}) / dt at the nodes (0 if steady)
   Eigen::Matrix<double, 3, 2> force;      // body force f at the nodes
+  Eigen::Matrix<double, 3, 2> velocity = Eigen::Matrix<double, 3, 2>::Zero();  // u_k (Newton linearisation point)
+  bool newton = false;  // add the Galerkin convection Jacobian (du . grad) u_k (SUPG/PSPG/tau stay Picard)
   Eigen::RowVector2d viscous = Eigen::RowVector2d::Zero();  // div(mu grad u*) in the element (0: not reconstructed)
   double density = 1;
   double viscosity = 1;  // dynamic
