@@ -193,6 +193,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
     params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
     params.krylov_refactor_iterations = ls->get<int>("krylov_refactor_iterations", params.krylov_refactor_iterations);
+    params.adaptive_refactorisation = ls->get<bool>("adaptive_refactorisation", params.adaptive_refactorisation);
   }
 
   // Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's

@@ -40,6 +40,8 @@ struct SparseLu::Impl {
   bool factorised = false;
   bool stale = false;  // the factors precondition poorly: refactorise at the next solve
   Ordering chosen = Ordering::Amd;
+  double cycle_seconds = 0;  // factorisation + solves since the last factorisation
+  int cycle_solves = 0;
   std::pair<double, double> measured{0, 0};  // auto: factorisation seconds with AMD, METIS
 };
 
@@ -61,10 +63,17 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
     krylov.setMaxIterations(p.krylov_max_iterations);
     krylov.compute(A);
     x = guess.size() == b.size() ? Eigen::VectorXd(krylov.solveWithGuess(b, guess)) : Eigen::VectorXd(krylov.solve(b));
-    report.solve_seconds += seconds_since(t_solve);
+    const double seconds = seconds_since(t_solve);
+    report.solve_seconds += seconds;
     if (krylov.info() == Eigen::Success && x.allFinite()) {
       report.krylov_iterations += static_cast<int>(krylov.iterations());
       if (krylov.iterations() > p.krylov_refactor_iterations) s.stale = true;
+      // Cost-based refactorisation: the factorisation's cost is shared by every solve that
+      // reuses it; once one more Krylov solve costs more than that running average (factorisation
+      // + its solves, per solve), a fresh factorisation is the cheaper next step.
+      s.cycle_seconds += seconds;
+      ++s.cycle_solves;
+      if (p.adaptive_refactorisation && seconds > s.cycle_seconds / s.cycle_solves) s.stale = true;
       return x;
     }
   }
@@ -116,6 +125,8 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
   const auto t_solve = Clock::now();
   x = s.lu->solve(b);
   report.solve_seconds += seconds_since(t_solve);
+  s.cycle_seconds = seconds_since(t_factor);
+  s.cycle_solves = 1;
   if (!x.allFinite()) throw SolverError(fmt::format("{}: the solution is not finite", where));
   return x;
 }

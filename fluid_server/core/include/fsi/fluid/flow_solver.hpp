@@ -58,6 +58,9 @@ struct FlowParameters {
   double krylov_tolerance = 1e-10;  // relative residual
   int krylov_max_iterations = 25;
   int krylov_refactor_iterations = 8;  // a solve needing more marks the factors stale: refactorise next time
+  // Refactorise as soon as a Krylov solve costs more than the average cost per solve of the
+  // current factors (their factorisation included): minimises the time per step.
+  bool adaptive_refactorisation = true;
 };
 
 struct StepReport {
