@@ -310,11 +310,33 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     if (method == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
     else if (method != "harmonic") iface.fail("mesh_motion", "must be 'harmonic' or 'elastic'");
     motion.incremental = iface.get<bool>("mesh_incremental", false);
-    // P2 meshes: the extension runs on the 4-triangle refinement of every element, so
-    // midpoints move with it and curved interface edges follow the solid.
-    motion_mesh_ = fluid_mesh.linear_refinement();  // MeshMotion keeps a pointer to it
-    motion_ = std::make_unique<MeshMotion>(motion_mesh_, solver.interface_nodes(),
-                                           fluid_mesh.boundary_nodes(fixed_groups), motion);
+    // P2 meshes: the interface midpoints take the solid's displacement (curved interface
+    // edges follow the solid); the extension runs either on the vertices (default: interior
+    // midpoints move with the mean of their edge's vertices, edges stay straight inside) or on
+    // the 4-triangle refinement of every element (every node extended; 4x the unknowns).
+    const auto on = fluid_mesh.quadratic() ? iface.get<std::string>("mesh_motion_nodes", "vertices") : "all";
+    if (fluid_mesh.quadratic() && on != "vertices" && on != "all")
+      iface.fail("mesh_motion_nodes", "must be 'vertices' or 'all', got '" + on + "'");
+    motion_on_vertices_ = fluid_mesh.quadratic() && on == "vertices";
+    std::vector<int> moving = solver.interface_nodes(), fixed = fluid_mesh.boundary_nodes(fixed_groups);
+    if (motion_on_vertices_) {
+      const int nv = fluid_mesh.vertices();
+      motion_mesh_.nodes = fluid_mesh.nodes.topRows(nv);
+      motion_mesh_.triangles = fluid_mesh.triangles;
+      motion_mesh_.boundaries = fluid_mesh.boundaries;
+      motion_vertex_index_.clear();
+      std::vector<int> vertex_nodes;
+      for (std::size_t i = 0; i < moving.size(); ++i)
+        if (moving[i] < nv) {
+          motion_vertex_index_.push_back(static_cast<int>(i));
+          vertex_nodes.push_back(moving[i]);
+        }
+      moving = vertex_nodes;
+      fixed.erase(std::remove_if(fixed.begin(), fixed.end(), [nv](int n) { return n >= nv; }), fixed.end());
+    } else {
+      motion_mesh_ = fluid_mesh.linear_refinement();
+    }
+    motion_ = std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion);  // keeps a pointer to motion_mesh_
   }
 
   // --- probes and output ---
@@ -350,6 +372,29 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
   start_ = last_log_ = std::chrono::steady_clock::now();
 }
 
+Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {
+  if (!motion_on_vertices_) return interface_displacement;
+  Eigen::VectorXd d(2 * static_cast<Eigen::Index>(motion_vertex_index_.size()));
+  for (std::size_t k = 0; k < motion_vertex_index_.size(); ++k)
+    d.segment<2>(2 * static_cast<Eigen::Index>(k)) = interface_displacement.segment<2>(2 * motion_vertex_index_[k]);
+  return d;
+}
+
+Eigen::MatrixX2d NavierStokesFluid::extend(const Eigen::VectorXd& interface_displacement) const {
+  const Eigen::MatrixX2d vertex = motion_->extend(motion_input(interface_displacement));
+  if (!motion_on_vertices_) return vertex;
+  const auto& mesh = solver_->mesh();
+  Eigen::MatrixX2d out(mesh.node_count(), 2);
+  out.topRows(mesh.vertices()) = vertex;
+  for (int e = 0; e < mesh.triangle_count(); ++e)
+    for (int k = 0; k < 3; ++k)
+      out.row(mesh.edge_nodes(e, k)) = 0.5 * (vertex.row(mesh.triangles(e, k)) + vertex.row(mesh.triangles(e, (k + 1) % 3)));
+  const auto& nodes = solver_->interface_nodes();
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    out.row(nodes[i]) = interface_displacement.segment<2>(2 * static_cast<Eigen::Index>(i)).transpose();
+  return out;
+}
+
 InterfaceMeshData NavierStokesFluid::interface() const {
   InterfaceMeshData data;
   const auto& nodes = solver_->interface_nodes();
@@ -375,7 +420,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   const auto t0 = std::chrono::steady_clock::now();
   Eigen::MatrixX2d positions = solver_->mesh().nodes;
   if (motion_ && interface_displacement.size() > 0) {
-    positions += motion_->extend(interface_displacement);
+    positions += extend(interface_displacement);
     last_interface_displacement_ = interface_displacement;
   }
   try {
@@ -404,7 +449,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
 
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
   solver_->accept();
-  if (motion_ && last_interface_displacement_.size() > 0) motion_->accept(last_interface_displacement_);
+  if (motion_ && last_interface_displacement_.size() > 0) motion_->accept(motion_input(last_interface_displacement_));
   std::map<std::string, double> probes;
   for (const auto& f : forces_) {
     const Eigen::Vector2d force = solver_->force(f.groups);

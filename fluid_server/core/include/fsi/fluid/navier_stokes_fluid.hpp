@@ -61,7 +61,11 @@ class NavierStokesFluid : public FluidModel {
   };
   FluidSetup setup_;
   std::unique_ptr<FlowSolver> solver_;
-  FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: 4 linear triangles per element)
+  FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
+  bool motion_on_vertices_ = false;
+  std::vector<int> motion_vertex_index_;  // P2 on vertices: interface index of each moving vertex
+  Eigen::VectorXd motion_input(const Eigen::VectorXd& interface_displacement) const;
+  Eigen::MatrixX2d extend(const Eigen::VectorXd& interface_displacement) const;  // every node
   std::unique_ptr<MeshMotion> motion_;
   std::vector<ForceProbe> forces_;
   std::vector<std::pair<std::string, Eigen::Vector2d>> pressure_probes_;
