@@ -13,6 +13,7 @@
 
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/sparse_lu.hpp"
+#include "flow_common.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -155,16 +156,7 @@ void NavierStokesSolver::add_dirichlet(const std::string& group, VelocityFunctio
 }
 
 void NavierStokesSolver::add_symmetry(const std::string& group) {
-  const auto& seg = mesh_.boundary(group);
-  Eigen::Vector2d span = Eigen::Vector2d::Zero();
-  for (Eigen::Index e = 0; e < seg.rows(); ++e)
-    span += (mesh_.nodes.row(seg(e, 1)) - mesh_.nodes.row(seg(e, 0))).transpose().cwiseAbs();
-  const double tol = 1e-8 * span.norm();
-  int component;
-  if (span.y() <= tol) component = 1;       // horizontal boundary: v = 0
-  else if (span.x() <= tol) component = 0;  // vertical boundary: u = 0
-  else throw std::runtime_error("symmetry boundary '" + group + "' is not axis-aligned (only x = const or y = const)");
-  impl_->symmetry.push_back({mesh_.boundary_nodes({group}), component});
+  impl_->symmetry.push_back({mesh_.boundary_nodes({group}), detail::symmetry_component(mesh_, group)});
 }
 
 void NavierStokesSolver::set_interface(const std::vector<std::string>& groups) {
@@ -234,20 +226,8 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
   else interface_velocity_ = interface_velocity;
 
   // Time discretisation: du/dt ~ (alpha0 u + alpha1 u_n + alpha2 u_{n-1}) / dt.
-  double alpha0 = 0, alpha1 = 0, alpha2 = 0, extrap = 0;  // extrap: u* = (1+extrap) u_n - extrap u_{n-1}
   const bool steady = params_.scheme == TimeScheme::Steady;
-  if (!steady) {
-    if (params_.scheme == TimeScheme::BDF2 && accepted_ >= 1 && dt_n_ > 0) {
-      const double w = dt / dt_n_;
-      alpha0 = (1 + 2 * w) / (1 + w);
-      alpha1 = -(1 + w);
-      alpha2 = w * w / (1 + w);
-      extrap = w;
-    } else {
-      alpha0 = 1;
-      alpha1 = -1;
-    }
-  }
+  const auto [alpha0, alpha1, alpha2, extrap] = detail::bdf_coefficients(params_.scheme, accepted_, dt, dt_n_);
   // Mesh velocity (BDF-consistent with the time derivative of the velocity).
   Eigen::MatrixX2d mesh_velocity = Eigen::MatrixX2d::Zero(n, 2);
   if (!steady) mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
@@ -417,24 +397,13 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
     }
 
     // Strong constraints: identity rows.
-    const int* inner = A.innerIndexPtr();
-    for (int col = 0; col < ndof; ++col)
-      for (int k = outer[col]; k < outer[col + 1]; ++k)
-        if (constrained[static_cast<std::size_t>(inner[k])]) av[k] = inner[k] == col ? 1.0 : 0.0;
-    for (int d = 0; d < ndof; ++d)
-      if (constrained[static_cast<std::size_t>(d)]) rhs(d) = constraint_value(d);
+    detail::apply_constraints(A, rhs, constrained, constraint_value);
     report.assembly_seconds += seconds_since(t_assembly);
 
     const Eigen::VectorXd U_new =
         impl_->lu->solve(A, rhs, U_adv, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration));
 
-    double diff = 0, norm = 0;
-    for (int i = 0; i < n; ++i)
-      for (int c = 0; c < 2; ++c) {
-        diff += std::pow(U_new(3 * i + c) - U_adv(3 * i + c), 2);
-        norm += std::pow(U_new(3 * i + c), 2);
-      }
-    report.change = std::sqrt(diff / std::max(norm, 1e-300));
+    report.change = detail::relative_velocity_change(U_new, U_adv, n, [](int i, int c) { return 3 * i + c; });
     report.iterations = iteration;
     U_ = U_new;
     U_adv = U_new;
@@ -500,24 +469,7 @@ Eigen::VectorXd NavierStokesSolver::interface_traction() const {
 }
 
 bool NavierStokesSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const {
-  double best = -std::numeric_limits<double>::infinity();
-  for (int e = 0; e < mesh_.triangle_count(); ++e) {
-    Eigen::Matrix<double, 3, 2> x;
-    for (int k = 0; k < 3; ++k) x.row(k) = X_.row(mesh_.triangles(e, k));
-    const Eigen::Vector2d a = x.row(0), b = x.row(1), c = x.row(2);
-    Eigen::Matrix2d J;
-    J << b - a, c - a;
-    const Eigen::Vector2d s = J.inverse() * (point - a);
-    const Eigen::Vector3d l(1 - s(0) - s(1), s(0), s(1));
-    const double m = l.minCoeff();
-    if (m > best) {
-      best = m;
-      element = e;
-      bary = l;
-      if (m >= 0) return true;
-    }
-  }
-  return best > -1e-9;
+  return detail::locate(mesh_, X_, point, element, bary);
 }
 
 double NavierStokesSolver::pressure_at(const Eigen::Vector2d& point) const {

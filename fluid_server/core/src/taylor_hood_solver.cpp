@@ -14,6 +14,7 @@
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/p2p1_element.hpp"
 #include "fsi/fluid/sparse_lu.hpp"
+#include "flow_common.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -172,16 +173,7 @@ void TaylorHoodSolver::add_dirichlet(const std::string& group, VelocityFunction 
 }
 
 void TaylorHoodSolver::add_symmetry(const std::string& group) {
-  const auto& seg = mesh_.boundary(group);
-  Eigen::Vector2d span = Eigen::Vector2d::Zero();
-  for (Eigen::Index e = 0; e < seg.rows(); ++e)
-    span += (mesh_.nodes.row(seg(e, 1)) - mesh_.nodes.row(seg(e, 0))).transpose().cwiseAbs();
-  const double tol = 1e-8 * span.norm();
-  int component;
-  if (span.y() <= tol) component = 1;
-  else if (span.x() <= tol) component = 0;
-  else throw std::runtime_error("symmetry boundary '" + group + "' is not axis-aligned (only x = const or y = const)");
-  impl_->symmetry.push_back({mesh_.boundary_nodes({group}), component});
+  impl_->symmetry.push_back({mesh_.boundary_nodes({group}), detail::symmetry_component(mesh_, group)});
 }
 
 void TaylorHoodSolver::set_interface(const std::vector<std::string>& groups) {
@@ -246,20 +238,8 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
                                             2 * interface_nodes_.size()));
   else interface_velocity_ = interface_velocity;
 
-  double alpha0 = 0, alpha1 = 0, alpha2 = 0, extrap = 0;
   const bool steady = params_.scheme == TimeScheme::Steady;
-  if (!steady) {
-    if (params_.scheme == TimeScheme::BDF2 && accepted_ >= 1 && dt_n_ > 0) {
-      const double w = dt / dt_n_;
-      alpha0 = (1 + 2 * w) / (1 + w);
-      alpha1 = -(1 + w);
-      alpha2 = w * w / (1 + w);
-      extrap = w;
-    } else {
-      alpha0 = 1;
-      alpha1 = -1;
-    }
-  }
+  const auto [alpha0, alpha1, alpha2, extrap] = detail::bdf_coefficients(params_.scheme, accepted_, dt, dt_n_);
   Eigen::MatrixX2d mesh_velocity = Eigen::MatrixX2d::Zero(n, 2);
   if (!steady) mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
   Eigen::VectorXd U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
@@ -400,24 +380,13 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
       for (int i = 0; i < 15; ++i) rhs(d[static_cast<std::size_t>(i)]) += local_rhs(i);
     }
 
-    const int* outer = A.outerIndexPtr();
-    const int* inner = A.innerIndexPtr();
-    for (int col = 0; col < ndof; ++col)
-      for (int k = outer[col]; k < outer[col + 1]; ++k)
-        if (constrained[static_cast<std::size_t>(inner[k])]) av[k] = inner[k] == col ? 1.0 : 0.0;
-    for (int d = 0; d < ndof; ++d)
-      if (constrained[static_cast<std::size_t>(d)]) rhs(d) = constraint_value(d);
+    detail::apply_constraints(A, rhs, constrained, constraint_value);
     report.assembly_seconds += seconds_since(t_assembly);
 
     Eigen::VectorXd U_new =
         im.lu->solve(A, rhs, U_lin, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration));
 
-    double diff = 0, norm = 0;
-    for (int i = 0; i < 2 * n; ++i) {
-      diff += std::pow(U_new(i) - U_lin(i), 2);
-      norm += std::pow(U_new(i), 2);
-    }
-    double change = std::sqrt(diff / std::max(norm, 1e-300));
+    double change = detail::relative_velocity_change(U_new, U_lin, n, [](int i, int c) { return 2 * i + c; });
     // Damped Newton: an update that grows the change is halved (iterations 3 on, so the first
     // Oseen/Stokes solve and the first Newton correction are always taken whole).
     if (params_.newton && iteration >= 3 && change > previous_change) {
@@ -499,22 +468,7 @@ Eigen::VectorXd TaylorHoodSolver::interface_traction() const {
 }
 
 bool TaylorHoodSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const {
-  double best = -std::numeric_limits<double>::infinity();
-  for (int e = 0; e < mesh_.triangle_count(); ++e) {
-    const Eigen::Vector2d a = X_.row(mesh_.triangles(e, 0)), b = X_.row(mesh_.triangles(e, 1)), c = X_.row(mesh_.triangles(e, 2));
-    Eigen::Matrix2d J;
-    J << b - a, c - a;
-    const Eigen::Vector2d s = J.inverse() * (point - a);
-    const Eigen::Vector3d l(1 - s(0) - s(1), s(0), s(1));
-    const double m = l.minCoeff();
-    if (m > best) {
-      best = m;
-      element = e;
-      bary = l;
-      if (m >= 0) return true;
-    }
-  }
-  return best > -1e-9;
+  return detail::locate(mesh_, X_, point, element, bary);
 }
 
 double TaylorHoodSolver::pressure_at(const Eigen::Vector2d& point) const {

@@ -1,0 +1,101 @@
+#pragma once
+// Pieces both fluid solvers (P1/P1 and Taylor-Hood P2/P1) share: the variable-step BDF
+// coefficients, the axis of a symmetry boundary, the point location on the vertex triangles,
+// the strong constraints as identity rows, the relative velocity change. Private to fsi_fluid.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fsi/fluid/flow_solver.hpp"
+
+namespace fsi::fluid::detail {
+
+// du/dt ~ (alpha0 u + alpha1 u_n + alpha2 u_{n-1}) / dt; the semi-implicit advection velocity
+// u* = (1 + extrap) u_n - extrap u_{n-1}. BDF2 with variable steps (first step BDF1).
+struct BdfCoefficients {
+  double alpha0 = 0, alpha1 = 0, alpha2 = 0, extrap = 0;
+};
+
+inline BdfCoefficients bdf_coefficients(TimeScheme scheme, int accepted_steps, double dt, double dt_previous) {
+  BdfCoefficients c;
+  if (scheme == TimeScheme::Steady) return c;
+  if (scheme == TimeScheme::BDF2 && accepted_steps >= 1 && dt_previous > 0) {
+    const double w = dt / dt_previous;
+    c.alpha0 = (1 + 2 * w) / (1 + w);
+    c.alpha1 = -(1 + w);
+    c.alpha2 = w * w / (1 + w);
+    c.extrap = w;
+  } else {
+    c.alpha0 = 1;
+    c.alpha1 = -1;
+  }
+  return c;
+}
+
+// The velocity component a symmetry group constrains: 1 (v) on y = const, 0 (u) on x = const.
+inline int symmetry_component(const FluidMesh& mesh, const std::string& group) {
+  const auto& seg = mesh.boundary(group);
+  Eigen::Vector2d span = Eigen::Vector2d::Zero();
+  for (Eigen::Index e = 0; e < seg.rows(); ++e)
+    span += (mesh.nodes.row(seg(e, 1)) - mesh.nodes.row(seg(e, 0))).transpose().cwiseAbs();
+  const double tol = 1e-8 * span.norm();
+  if (span.y() <= tol) return 1;
+  if (span.x() <= tol) return 0;
+  throw std::runtime_error("symmetry boundary '" + group + "' is not axis-aligned (only x = const or y = const)");
+}
+
+// The vertex triangle of `mesh` (at positions X) holding `point`, with barycentric
+// coordinates; false when the point is outside (by more than round-off).
+inline bool locate(const FluidMesh& mesh, const Eigen::MatrixX2d& X, const Eigen::Vector2d& point, int& element,
+                   Eigen::Vector3d& bary) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (int e = 0; e < mesh.triangle_count(); ++e) {
+    const Eigen::Vector2d a = X.row(mesh.triangles(e, 0)), b = X.row(mesh.triangles(e, 1)), c = X.row(mesh.triangles(e, 2));
+    Eigen::Matrix2d J;
+    J << b - a, c - a;
+    const Eigen::Vector2d s = J.inverse() * (point - a);
+    const Eigen::Vector3d l(1 - s(0) - s(1), s(0), s(1));
+    const double m = l.minCoeff();
+    if (m > best) {
+      best = m;
+      element = e;
+      bary = l;
+      if (m >= 0) return true;
+    }
+  }
+  return best > -1e-9;
+}
+
+// Strong constraints: the constrained rows of A become identity rows, their rhs the value.
+inline void apply_constraints(Eigen::SparseMatrix<double>& A, Eigen::VectorXd& rhs, const std::vector<char>& constrained,
+                              const Eigen::VectorXd& value) {
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  double* av = A.valuePtr();
+  for (Eigen::Index col = 0; col < A.cols(); ++col)
+    for (int k = outer[col]; k < outer[col + 1]; ++k)
+      if (constrained[static_cast<std::size_t>(inner[k])]) av[k] = inner[k] == col ? 1.0 : 0.0;
+  for (Eigen::Index d = 0; d < rhs.size(); ++d)
+    if (constrained[static_cast<std::size_t>(d)]) rhs(d) = value(d);
+}
+
+// ||u_new - u_old|| / ||u_new|| over the velocity unknowns (index(i, c) for node i, component c).
+template <class Index>
+double relative_velocity_change(const Eigen::VectorXd& u_new, const Eigen::VectorXd& u_old, int nodes, Index index) {
+  double diff = 0, norm = 0;
+  for (int i = 0; i < nodes; ++i)
+    for (int c = 0; c < 2; ++c) {
+      const int k = index(i, c);
+      diff += std::pow(u_new(k) - u_old(k), 2);
+      norm += std::pow(u_new(k), 2);
+    }
+  return std::sqrt(diff / std::max(norm, 1e-300));
+}
+
+}  // namespace fsi::fluid::detail
