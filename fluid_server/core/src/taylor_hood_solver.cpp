@@ -88,6 +88,7 @@ struct TaylorHoodSolver::Impl {
   std::function<double(double)> pressure_value;
   VelocityFunction body_force;
   std::vector<std::vector<double>> thread_values;
+  Eigen::VectorXd last_rhs;
   int n = 0, nv = 0;
   std::array<int, 15> element_dofs(const FluidMesh& m, int e) const {
     std::array<int, 15> d{};
@@ -383,6 +384,7 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
     detail::apply_constraints(A, rhs, constrained, constraint_value);
     report.assembly_seconds += seconds_since(t_assembly);
 
+    im.last_rhs = rhs;
     Eigen::VectorXd U_new =
         im.lu->solve(A, rhs, U_lin, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration));
 
@@ -403,6 +405,9 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
   }
   return report;
 }
+
+const Eigen::SparseMatrix<double>& TaylorHoodSolver::last_matrix() const { return impl_->matrix; }
+const Eigen::VectorXd& TaylorHoodSolver::last_rhs() const { return impl_->last_rhs; }
 
 void TaylorHoodSolver::accept() {
   U_nm1_ = U_n_;

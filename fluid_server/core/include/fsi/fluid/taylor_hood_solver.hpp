@@ -11,6 +11,7 @@
 // Unknowns: (u, v) at every node (vertices and midpoints) at 2 i, 2 i + 1, p at the vertices
 // after them (2 n + i). Interface quantities live at every interface node.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <memory>
 #include <string>
@@ -42,6 +43,10 @@ class TaylorHoodSolver : public FlowSolver {
   const FlowParameters& parameters() const override { return params_; }
   int dofs() const override { return 2 * mesh_.node_count() + mesh_.vertices(); }
   const Eigen::VectorXd& solution() const { return U_; }
+  // The system of the last solve (constraints applied) and its right-hand side: for the
+  // linear-solver benchmark (bench/fluid/linear_solver_bench.cpp).
+  const Eigen::SparseMatrix<double>& last_matrix() const;
+  const Eigen::VectorXd& last_rhs() const;
   Eigen::MatrixX2d velocity() const override;
   Eigen::VectorXd pressure() const override;
   const Eigen::MatrixX2d& positions() const override { return X_; }
