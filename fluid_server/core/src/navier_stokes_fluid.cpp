@@ -145,6 +145,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     params.max_iterations = nl->get<int>("max_iterations", params.max_iterations);
     params.tolerance = nl->get<double>("tolerance", params.tolerance);
     if (params.max_iterations < 1) nl->fail("max_iterations", "must be at least 1");
+    params.relinearise = nl->get<bool>("relinearise", params.relinearise);
     method = nl->get<std::string>("method", method);
     if (method != "picard" && method != "newton") nl->fail("method", "must be picard or newton, got '" + method + "'");
   }

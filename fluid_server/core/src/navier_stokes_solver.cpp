@@ -233,6 +233,8 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
   if (!steady) mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
 
   Eigen::VectorXd U_adv = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
+  if (params_.relinearise && trial_solves_ > 0) U_adv = U_;  // a coupling iteration: about the last iterate
+  ++trial_solves_;
   Eigen::VectorXd history = Eigen::VectorXd::Zero(ndof);
   if (!steady) history = (alpha1 * U_n_ + alpha2 * U_nm1_) / dt;
 
@@ -420,6 +422,7 @@ void NavierStokesSolver::accept() {
   X_n_ = X_;
   dt_n_ = dt_trial_;
   ++accepted_;
+  trial_solves_ = 0;
 }
 
 Eigen::MatrixX2d NavierStokesSolver::velocity() const {

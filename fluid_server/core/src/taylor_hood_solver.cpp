@@ -244,6 +244,8 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
   Eigen::MatrixX2d mesh_velocity = Eigen::MatrixX2d::Zero(n, 2);
   if (!steady) mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
   Eigen::VectorXd U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
+  if (params_.relinearise && trial_solves_ > 0) U_lin = U_;  // a coupling iteration: about the last iterate
+  ++trial_solves_;
   Eigen::VectorXd history = Eigen::VectorXd::Zero(ndof);
   if (!steady) history = (alpha1 * U_n_ + alpha2 * U_nm1_) / dt;
 
@@ -416,6 +418,7 @@ void TaylorHoodSolver::accept() {
   X_n_ = X_;
   dt_n_ = dt_trial_;
   ++accepted_;
+  trial_solves_ = 0;
 }
 
 Eigen::MatrixX2d TaylorHoodSolver::velocity() const {

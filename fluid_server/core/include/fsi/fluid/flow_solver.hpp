@@ -45,6 +45,10 @@ struct FlowParameters {
   // Oseen operator); false: Picard (Oseen) iterations. The first solve of a time step always
   // advects with the extrapolated velocity, so max_iterations = 1 is the semi-implicit scheme.
   bool newton = false;
+  // A repeated solve of the same time level (a coupling iteration) linearises about the last
+  // solve's velocity instead of the extrapolation, so converged coupling iterations give the
+  // fully implicit step (at no extra solve); false: every coupling iteration is semi-implicit.
+  bool relinearise = false;
   StabilisationParameters stabilisation;
   double nitsche_penalty = 0;    // gamma_N1
   double nitsche_symmetry = -1;  // gamma_N2 (+1 symmetric, -1 unsymmetric)

@@ -82,6 +82,7 @@ class NavierStokesSolver : public FlowSolver {
   double dt_n_ = 0;      // last accepted step size
   double dt_trial_ = 0;  // step size of the last solve
   int accepted_ = 0;
+  int trial_solves_ = 0;  // solves of the current time level since the last accept()
   std::vector<int> interface_nodes_;
   IndexMatrix2 interface_segments_;
   Eigen::VectorXd interface_velocity_;  // of the last solve

@@ -67,6 +67,7 @@ class TaylorHoodSolver : public FlowSolver {
   Eigen::MatrixX2d X_, X_n_, X_nm1_;
   double dt_n_ = 0, dt_trial_ = 0;
   int accepted_ = 0;
+  int trial_solves_ = 0;  // solves of the current time level since the last accept()
   std::vector<int> interface_nodes_;
   IndexMatrix2 interface_segments_;
   Eigen::VectorXd interface_velocity_;
