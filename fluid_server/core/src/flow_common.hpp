@@ -16,6 +16,45 @@
 
 namespace fsi::fluid::detail {
 
+struct DirichletCondition {
+  std::vector<int> nodes;
+  VelocityFunction velocity;
+};
+
+struct SymmetryCondition {
+  std::vector<int> nodes;
+  int component;  // constrained velocity component (normal to the boundary)
+};
+
+// The strong constraints at `time` on the positions X: which unknowns, and their values.
+// dof(node, c) is the velocity unknown; pressure_dof < 0 means no pressure reference.
+struct StrongConstraints {
+  std::vector<char> on;
+  Eigen::VectorXd value;
+};
+
+template <class VelocityDof>
+StrongConstraints strong_constraints(int ndof, const std::vector<DirichletCondition>& dirichlet,
+                                     const std::vector<SymmetryCondition>& symmetry, const Eigen::MatrixX2d& X,
+                                     double time, VelocityDof dof, int pressure_dof, double pressure_value) {
+  StrongConstraints k{std::vector<char>(static_cast<std::size_t>(ndof), 0), Eigen::VectorXd::Zero(ndof)};
+  for (const auto& sym : symmetry)
+    for (int node : sym.nodes) k.on[static_cast<std::size_t>(dof(node, sym.component))] = 1;
+  for (const auto& dc : dirichlet)
+    for (int node : dc.nodes) {
+      const Eigen::Vector2d v = dc.velocity(X.row(node).transpose(), time);
+      for (int c = 0; c < 2; ++c) {
+        k.on[static_cast<std::size_t>(dof(node, c))] = 1;
+        k.value(dof(node, c)) = v(c);
+      }
+    }
+  if (pressure_dof >= 0) {
+    k.on[static_cast<std::size_t>(pressure_dof)] = 1;
+    k.value(pressure_dof) = pressure_value;
+  }
+  return k;
+}
+
 // du/dt ~ (alpha0 u + alpha1 u_n + alpha2 u_{n-1}) / dt; the semi-implicit advection velocity
 // u* = (1 + extrap) u_n - extrap u_{n-1}. BDF2 with variable steps (first step BDF1).
 struct BdfCoefficients {

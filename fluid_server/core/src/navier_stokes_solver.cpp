@@ -25,16 +25,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-struct DirichletCondition {
-  std::vector<int> nodes;
-  VelocityFunction velocity;
-};
-
-struct SymmetryCondition {
-  std::vector<int> nodes;
-  int component;  // constrained velocity component (normal to the boundary)
-};
-
 // A boundary segment on the Nitsche interface with its parent triangle.
 struct InterfaceSegment {
   int element;
@@ -89,8 +79,8 @@ struct NavierStokesSolver::Impl {
   Eigen::SparseMatrix<double> volume;       // volume terms only (for reactions)
   std::vector<std::array<int, 9>> scatter;  // per element: 3*k offset of node a in adj(node b) -> index a*3+b
   std::unique_ptr<SparseLu> lu;
-  std::vector<DirichletCondition> dirichlet;
-  std::vector<SymmetryCondition> symmetry;
+  std::vector<detail::DirichletCondition> dirichlet;
+  std::vector<detail::SymmetryCondition> symmetry;
   std::vector<InterfaceSegment> segments;
   int pressure_node = -1;
   std::function<double(double)> pressure_value;
@@ -239,22 +229,9 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
   if (!steady) history = (alpha1 * U_n_ + alpha2 * U_nm1_) / dt;
 
   // Constraints at t_{n+1} on the current positions.
-  std::vector<char> constrained(static_cast<std::size_t>(ndof), 0);
-  Eigen::VectorXd constraint_value = Eigen::VectorXd::Zero(ndof);
-  for (const auto& sym : impl_->symmetry)
-    for (int node : sym.nodes) constrained[static_cast<std::size_t>(3 * node + sym.component)] = 1;
-  for (const auto& dc : impl_->dirichlet)
-    for (int node : dc.nodes) {
-      const Eigen::Vector2d v = dc.velocity(X_.row(node).transpose(), time);
-      for (int c = 0; c < 2; ++c) {
-        constrained[static_cast<std::size_t>(3 * node + c)] = 1;
-        constraint_value(3 * node + c) = v(c);
-      }
-    }
-  if (impl_->pressure_node >= 0) {
-    constrained[static_cast<std::size_t>(3 * impl_->pressure_node + 2)] = 1;
-    constraint_value(3 * impl_->pressure_node + 2) = impl_->pressure_value ? impl_->pressure_value(time) : 0.0;
-  }
+  const auto constraints = detail::strong_constraints(ndof, impl_->dirichlet, impl_->symmetry, X_, time,
+                                                      [](int i, int c) { return 3 * i + c; },
+                                                      impl_->pressure_node >= 0 ? 3 * impl_->pressure_node + 2 : -1, impl_->pressure_value ? impl_->pressure_value(time) : 0.0);
   Eigen::MatrixX2d body = Eigen::MatrixX2d::Zero(n, 2);
   if (impl_->body_force)
     for (int i = 0; i < n; ++i) body.row(i) = impl_->body_force(X_.row(i).transpose(), time).transpose();
@@ -399,7 +376,7 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
     }
 
     // Strong constraints: identity rows.
-    detail::apply_constraints(A, rhs, constrained, constraint_value);
+    detail::apply_constraints(A, rhs, constraints.on, constraints.value);
     report.assembly_seconds += seconds_since(t_assembly);
 
     const Eigen::VectorXd U_new =

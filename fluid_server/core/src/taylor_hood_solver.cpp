@@ -26,16 +26,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-struct DirichletCondition {
-  std::vector<int> nodes;
-  VelocityFunction velocity;
-};
-
-struct SymmetryCondition {
-  std::vector<int> nodes;
-  int component;
-};
-
 // A boundary edge on the Nitsche interface: its triangle, the local edge k (vertices k, k+1,
 // midpoint 3 + k) and the interface indices of those three nodes.
 struct InterfaceEdge {
@@ -81,8 +71,8 @@ struct TaylorHoodSolver::Impl {
   Eigen::SparseMatrix<double> matrix, volume;
   std::vector<int> scatter;  // per element 15 x 15 positions in valuePtr (column-major local)
   std::unique_ptr<SparseLu> lu;
-  std::vector<DirichletCondition> dirichlet;
-  std::vector<SymmetryCondition> symmetry;
+  std::vector<detail::DirichletCondition> dirichlet;
+  std::vector<detail::SymmetryCondition> symmetry;
   std::vector<InterfaceEdge> edges;
   int pressure_vertex = -1;
   std::function<double(double)> pressure_value;
@@ -249,22 +239,9 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
   Eigen::VectorXd history = Eigen::VectorXd::Zero(ndof);
   if (!steady) history = (alpha1 * U_n_ + alpha2 * U_nm1_) / dt;
 
-  std::vector<char> constrained(static_cast<std::size_t>(ndof), 0);
-  Eigen::VectorXd constraint_value = Eigen::VectorXd::Zero(ndof);
-  for (const auto& sym : im.symmetry)
-    for (int node : sym.nodes) constrained[static_cast<std::size_t>(2 * node + sym.component)] = 1;
-  for (const auto& dc : im.dirichlet)
-    for (int node : dc.nodes) {
-      const Eigen::Vector2d v = dc.velocity(X_.row(node).transpose(), time);
-      for (int c = 0; c < 2; ++c) {
-        constrained[static_cast<std::size_t>(2 * node + c)] = 1;
-        constraint_value(2 * node + c) = v(c);
-      }
-    }
-  if (im.pressure_vertex >= 0) {
-    constrained[static_cast<std::size_t>(2 * n + im.pressure_vertex)] = 1;
-    constraint_value(2 * n + im.pressure_vertex) = im.pressure_value ? im.pressure_value(time) : 0.0;
-  }
+  const auto constraints = detail::strong_constraints(ndof, im.dirichlet, im.symmetry, X_, time,
+                                                      [](int i, int c) { return 2 * i + c; },
+                                                      im.pressure_vertex >= 0 ? 2 * n + im.pressure_vertex : -1, im.pressure_value ? im.pressure_value(time) : 0.0);
   Eigen::MatrixX2d body = Eigen::MatrixX2d::Zero(n, 2);
   if (im.body_force)
     for (int i = 0; i < n; ++i) body.row(i) = im.body_force(X_.row(i).transpose(), time).transpose();
@@ -383,7 +360,7 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
       for (int i = 0; i < 15; ++i) rhs(d[static_cast<std::size_t>(i)]) += local_rhs(i);
     }
 
-    detail::apply_constraints(A, rhs, constrained, constraint_value);
+    detail::apply_constraints(A, rhs, constraints.on, constraints.value);
     report.assembly_seconds += seconds_since(t_assembly);
 
     im.last_rhs = rhs;
