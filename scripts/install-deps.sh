@@ -3,7 +3,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build git pkg-config
-  libeigen3-dev libsuitesparse-dev libopenblas0-pthread
+  libeigen3-dev libsuitesparse-dev zlib1g-dev libopenblas0-pthread
   libprotobuf-dev protobuf-compiler libzmq3-dev cppzmq-dev
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libgtest-dev
   gmsh

@@ -26,6 +26,10 @@ fsi::v1::Reply ProtocolClient::call(fsi::v1::Request request) {
     std::string bytes;
     try {
       bytes = client_.receive(std::max(left, std::chrono::milliseconds(1)));
+    } catch (const transport::TimeoutError& e) {
+      throw transport::TimeoutError(fmt::format("{} (request '{}', sequence {})", e.what(), what, sequence_));
+    } catch (const transport::PeerLostError& e) {
+      throw transport::PeerLostError(fmt::format("{} (request '{}', sequence {})", e.what(), what, sequence_));
     } catch (const transport::TransportError& e) {
       throw transport::TransportError(fmt::format("{} (request '{}', sequence {})", e.what(), what, sequence_));
     }

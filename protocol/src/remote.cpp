@@ -76,7 +76,8 @@ fsi::v1::Request configure_request(const ConfigSection& section, double dt, doub
   return r;
 }
 
-std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* supports_damping) {
+std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* supports_damping,
+                  bool* supports_checkpoint) {
   fsi::v1::Request r;
   r.mutable_hello()->set_client_name("fsi coupler");
   const auto reply = client.call(r);
@@ -88,6 +89,7 @@ std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* su
                                   client.endpoint(), fsi::v1::ServerKind_Name(reply.hello().kind()),
                                   fsi::v1::ServerKind_Name(expected)));
   if (supports_damping) *supports_damping = reply.hello().supports_interface_damping();
+  *supports_checkpoint = reply.hello().supports_checkpoint();
   return reply.hello().server_name();
 }
 
@@ -139,6 +141,23 @@ std::vector<std::string> output_call(ProtocolClient& client, const StepInfo& inf
   return {reply.output().files().begin(), reply.output().files().end()};
 }
 
+std::string save_call(ProtocolClient& client, int step, double time) {
+  fsi::v1::Request r;
+  r.mutable_save_checkpoint()->set_step(static_cast<unsigned>(step));
+  r.mutable_save_checkpoint()->set_time(time);
+  const auto reply = client.call(r);
+  expect(reply.has_checkpoint(), client, "save_checkpoint");
+  return reply.checkpoint().state();
+}
+
+void load_call(ProtocolClient& client, int step, double time, const std::string& bytes) {
+  fsi::v1::Request r;
+  r.mutable_load_checkpoint()->set_step(static_cast<unsigned>(step));
+  r.mutable_load_checkpoint()->set_time(time);
+  r.mutable_load_checkpoint()->set_state(bytes);
+  expect(client.call(r).has_loaded(), client, "load_checkpoint");
+}
+
 void stop_call(ProtocolClient& client, const std::string& reason) {
   fsi::v1::Request r;
   r.mutable_stop()->set_reason(reason);
@@ -150,7 +169,12 @@ void stop_call(ProtocolClient& client, const std::string& reason) {
 
 // ---------------------------------------------------------------------------- solid
 RemoteSolid::RemoteSolid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
-  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_);
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_);
+}
+
+std::string RemoteSolid::save_checkpoint(int step, double time) { return save_call(*client_, step, time); }
+void RemoteSolid::load_checkpoint(int step, double time, const std::string& bytes) {
+  load_call(*client_, step, time, bytes);
 }
 
 void RemoteSolid::configure(const ConfigSection& section, const SolidSetup& setup) {
@@ -193,7 +217,12 @@ void RemoteSolid::stop(const std::string& reason) { stop_call(*client_, reason);
 
 // ---------------------------------------------------------------------------- fluid
 RemoteFluid::RemoteFluid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
-  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_FLUID, nullptr);
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_FLUID, nullptr, &supports_checkpoint_);
+}
+
+std::string RemoteFluid::save_checkpoint(int step, double time) { return save_call(*client_, step, time); }
+void RemoteFluid::load_checkpoint(int step, double time, const std::string& bytes) {
+  load_call(*client_, step, time, bytes);
 }
 
 void RemoteFluid::configure(const ConfigSection& section, const FluidSetup& setup) {

@@ -57,7 +57,9 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
     stop = true;
     return true;
   }
-  if (body != R::kGetInterface && body != R::kAcceptStep && body != R::kWriteOutput) return false;
+  if (body != R::kGetInterface && body != R::kAcceptStep && body != R::kWriteOutput && body != R::kSaveCheckpoint &&
+      body != R::kLoadCheckpoint)
+    return false;
   if (!model)
     throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, fmt::format("'{}' before 'configure'", body_name(request)));
   if (body == R::kGetInterface) {
@@ -67,6 +69,24 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
     auto* out = reply.mutable_accept();
     for (const auto& [k, v] : model->accept_step(info)) (*out->mutable_probes())[k] = v;
     for (const auto& [k, v] : model->timings()) (*out->mutable_timings())[k] = v;
+  } else if (body == R::kSaveCheckpoint || body == R::kLoadCheckpoint) {
+    if (!model->supports_checkpoint())
+      throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                        fmt::format("model '{}' does not support checkpoints", model->name()));
+    if (body == R::kSaveCheckpoint) {
+      StateArchive state;
+      model->save_state(state);
+      reply.mutable_checkpoint()->set_state(state.serialize());
+    } else {
+      const auto& l = request.load_checkpoint();
+      try {
+        model->load_state(StateArchive::parse(
+            l.state(), fmt::format("checkpoint of step {} for model '{}'", l.step(), model->name())));
+      } catch (const StateError& e) {
+        throw std::invalid_argument(e.what());
+      }
+      reply.mutable_loaded();
+    }
   } else {
     const StepInfo info{request.write_output().time(), dt, static_cast<int>(request.write_output().step()), 0};
     auto* out = reply.mutable_output();
@@ -143,6 +163,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       h->set_protocol_version(kProtocolVersion);
       h->set_supports_interface_damping(true);
       h->set_supports_output(true);
+      h->set_supports_checkpoint(true);
       break;
     }
     case R::kConfigure: {
@@ -210,6 +231,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       h->set_server_name(server_name_);
       h->set_protocol_version(kProtocolVersion);
       h->set_supports_output(true);
+      h->set_supports_checkpoint(true);
       break;
     }
     case R::kConfigure: {

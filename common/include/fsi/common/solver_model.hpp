@@ -7,6 +7,9 @@
 //
 // Call order (enforced by the service layer):
 //   configure() -> interface() -> { solve_step(k = 1..) ... accept_step() } ... -> write_output()
+// Checkpoints (optional, supports_checkpoint()): save_state() after an accepted step holds
+// everything the next step depends on; load_state() on a freshly configured model (same
+// scene) makes it continue exactly as the saved one would have, bit for bit.
 #include <Eigen/Core>
 
 #include <array>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/state.hpp"
 
 namespace fsi {
 
@@ -26,6 +30,15 @@ class SolverError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// A model asked for a checkpoint it cannot write.
+class CheckpointUnsupported : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+[[noreturn]] inline void unsupported_checkpoint(const std::string& model) {
+  throw CheckpointUnsupported("model '" + model + "' does not support checkpoints");
+}
 
 struct InterfaceMeshData {
   std::vector<std::int64_t> node_ids;
@@ -74,6 +87,20 @@ class SolidModel {
   // Cumulative wall seconds by category (e.g. "assembly", "linear_solve"), reported in
   // the run summary. Optional.
   virtual std::map<std::string, double> timings() const { return {}; }
+  // Checkpoints: the state after the last accepted step; see the call order above.
+  virtual bool supports_checkpoint() const { return false; }
+  virtual void save_state(StateArchive& /*state*/) { unsupported_checkpoint(name()); }
+  virtual void load_state(const StateArchive& /*state*/) { unsupported_checkpoint(name()); }
+  // The state as opaque bytes (what the coupler stores); a remote model forwards these to
+  // its server, an in-process one serialises save_state().
+  virtual std::string save_checkpoint(int /*step*/, double /*time*/) {
+    StateArchive s;
+    save_state(s);
+    return s.serialize();
+  }
+  virtual void load_checkpoint(int step, double /*time*/, const std::string& bytes) {
+    load_state(StateArchive::parse(bytes, name() + " checkpoint of step " + std::to_string(step)));
+  }
 };
 
 struct FluidSetup {
@@ -107,6 +134,20 @@ class FluidModel {
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
   // Cumulative wall seconds by category (e.g. "mesh_motion", "assembly", "linear_solve").
   virtual std::map<std::string, double> timings() const { return {}; }
+  // Checkpoints: the state after the last accepted step; see the call order above.
+  virtual bool supports_checkpoint() const { return false; }
+  virtual void save_state(StateArchive& /*state*/) { unsupported_checkpoint(name()); }
+  virtual void load_state(const StateArchive& /*state*/) { unsupported_checkpoint(name()); }
+  // The state as opaque bytes (what the coupler stores); a remote model forwards these to
+  // its server, an in-process one serialises save_state().
+  virtual std::string save_checkpoint(int /*step*/, double /*time*/) {
+    StateArchive s;
+    save_state(s);
+    return s.serialize();
+  }
+  virtual void load_checkpoint(int step, double /*time*/, const std::string& bytes) {
+    load_state(StateArchive::parse(bytes, name() + " checkpoint of step " + std::to_string(step)));
+  }
 };
 
 }  // namespace fsi

@@ -25,6 +25,9 @@ class RemoteSolid : public SolidModel {
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
+  bool supports_checkpoint() const override { return supports_checkpoint_; }
+  std::string save_checkpoint(int step, double time) override;
+  void load_checkpoint(int step, double time, const std::string& bytes) override;
   void stop(const std::string& reason);
   RemoteTimes times() const { return {client_->wall_seconds(), client_->server_compute_seconds()}; }
   ProtocolClient& client() { return *client_; }
@@ -34,6 +37,7 @@ class RemoteSolid : public SolidModel {
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "solid server";
   bool supports_damping_ = false;
+  bool supports_checkpoint_ = false;
   InterfaceMeshData interface_;
 };
 
@@ -48,6 +52,9 @@ class RemoteFluid : public FluidModel {
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
+  bool supports_checkpoint() const override { return supports_checkpoint_; }
+  std::string save_checkpoint(int step, double time) override;
+  void load_checkpoint(int step, double time, const std::string& bytes) override;
   void stop(const std::string& reason);
   RemoteTimes times() const { return {client_->wall_seconds(), client_->server_compute_seconds()}; }
   ProtocolClient& client() { return *client_; }
@@ -56,6 +63,7 @@ class RemoteFluid : public FluidModel {
   std::map<std::string, double> timings_;
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "fluid server";
+  bool supports_checkpoint_ = false;
   InterfaceMeshData interface_;
 };
 
