@@ -9,7 +9,9 @@
 //
 // A scene with a `coupling` section runs solid_server + fluid_server + coupler; a scene
 // with only `solid` (or only `fluid`) runs that server alone with --standalone.
-// Exit code: the coupler's (0 completed, 2 diverged, 1 failed).
+// Exit codes: 0 completed, 2 diverged, 1 failed (bad input or options, a dead peer that could
+// not be recovered, a crashed coupler), 130 interrupted (SIGINT / SIGTERM). Every way a run
+// ends leaves summary.json with its final status.
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/prctl.h>
@@ -25,8 +27,13 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+
 #include "fsi/common/config.hpp"
 #include "fsi/common/log.hpp"
+#include "fsi/common/run_report.hpp"
 
 namespace fs = std::filesystem;
 
@@ -85,27 +92,34 @@ void reap(Child& c, bool block) {
   if (r == c.pid) c.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-// Stops a child: waits `grace`, then SIGTERM, then SIGKILL. Always reaps.
-void stop(Child& c, std::chrono::milliseconds grace) {
-  const auto until = [&](std::chrono::milliseconds d) {
+// Stops children together: waits up to `grace` for them to exit by themselves, then
+// SIGTERM to all, up to `term_wait`, then SIGKILL. Always reaps.
+void stop_all(std::vector<Child*> children, std::chrono::milliseconds grace,
+              std::chrono::milliseconds term_wait = std::chrono::milliseconds(500)) {
+  const auto wait_all = [&](std::chrono::milliseconds d) {
     const auto end = std::chrono::steady_clock::now() + d;
-    while (c.alive() && std::chrono::steady_clock::now() < end) {
-      reap(c, false);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    while (std::chrono::steady_clock::now() < end) {
+      bool any = false;
+      for (auto* c : children) {
+        reap(*c, false);
+        any = any || c->alive();
+      }
+      if (!any) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   };
-  until(grace);
-  if (c.alive()) {
-    kill(-c.pid, SIGTERM);
-    kill(c.pid, SIGTERM);
-    until(std::chrono::seconds(3));
-  }
-  if (c.alive()) {
-    kill(-c.pid, SIGKILL);
-    kill(c.pid, SIGKILL);
-    reap(c, true);
-  }
+  wait_all(grace);
+  for (auto* c : children)
+    if (c->alive()) kill(-c->pid, SIGTERM), kill(c->pid, SIGTERM);
+  wait_all(term_wait);
+  for (auto* c : children)
+    if (c->alive()) {
+      kill(-c->pid, SIGKILL);
+      kill(c->pid, SIGKILL);
+      reap(*c, true);
+    }
 }
+void stop(Child& c, std::chrono::milliseconds grace) { stop_all({&c}, grace); }
 
 std::string tail(const fs::path& file, int lines) {
   std::ifstream in(file);
@@ -140,79 +154,281 @@ std::string wait_for_endpoint(Child& c, const fs::path& port_file, std::chrono::
 
 fs::path self_dir() { return fs::read_symlink("/proc/self/exe").parent_path(); }
 
-int run(const std::string& scene_path, const std::string& out_dir, const std::vector<std::string>& overrides,
-        const std::string& solid_command, const std::string& fluid_command, double timeout) {
-  auto log = fsi::logger("fsi");
-  const auto scene = fsi::Scene::load(scene_path, overrides);  // fails early on a bad file
-  const bool has_solid = scene.has("solid"), has_fluid = scene.has("fluid"), coupled = scene.has("coupling");
-  const fs::path out(out_dir), bin = self_dir();
-  fs::create_directories(out);
-  std::vector<std::string> sets;
-  for (const auto& o : overrides) sets.insert(sets.end(), {"--set", o});
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGKILL: return "SIGKILL";
+    case SIGSEGV: return "SIGSEGV";
+    case SIGABRT: return "SIGABRT";
+    case SIGBUS: return "SIGBUS";
+    case SIGFPE: return "SIGFPE";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
 
-  std::vector<Child> children;
-  int code = 1;
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return nullptr;
   try {
-    if (!coupled) {
-      // One solver alone.
+    return nlohmann::json::parse(in);
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+void write_json_atomic(const fs::path& file, const nlohmann::json& j) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << j.dump(2) << '\n';
+  }
+  fs::rename(tmp, file);
+}
+
+// Makes summary.json final when its writer could not: status, reason, and steps equal to
+// the rows of probes.csv. Creates it from the scene if the run never wrote one.
+void finalize_summary(const fs::path& out, const fsi::Scene& scene, const std::string& status,
+                      const std::string& reason, bool only_if_running) {
+  nlohmann::json j = read_json(out / "summary.json");
+  if (j.is_null() || !j.is_object()) {
+    fsi::RunReport report(out, scene, "fsi");
+    j = report.data();
+  } else if (only_if_running && j.value("status", std::string("running")) != "running") {
+    return;
+  }
+  j["status"] = status;
+  j["reason"] = reason;
+  j["steps"] = fsi::csv_rows(out / "probes.csv");
+  write_json_atomic(out / "summary.json", j);
+}
+
+// The newest complete checkpoint's manifest (null if none).
+nlohmann::json newest_checkpoint(const fs::path& out) {
+  const fs::path dir = out / "checkpoints";
+  if (!fs::is_directory(dir)) return nullptr;
+  std::vector<fs::path> folders;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_directory() && e.path().filename().string().rfind("step_", 0) == 0 &&
+        e.path().extension() != ".tmp" && fs::exists(e.path() / "manifest.json"))
+      folders.push_back(e.path());
+  std::sort(folders.rbegin(), folders.rend());
+  for (const auto& f : folders) {
+    auto j = read_json(f / "manifest.json");
+    if (j.is_object()) return j;
+  }
+  return nullptr;
+}
+
+struct Server {
+  std::string side;     // "solid" / "fluid"
+  std::string command;  // external command ("" = ours)
+  std::string endpoint;
+  fs::path port_file, log;
+};
+
+Child start_server(Server& s, const fs::path& bin, const std::string& bind, std::chrono::seconds timeout) {
+  const std::string server = s.side + "_server";
+  fs::remove(s.port_file);
+  Child c;
+  if (s.command.empty()) {
+    c = spawn(server, {(bin / server).string(), "--bind", bind, "--port-file", s.port_file.string()}, s.log);
+  } else {
+    const std::string shell = fmt::format("exec {} --bind '{}' --port-file '{}'", s.command, bind, s.port_file.string());
+    c = spawn(server + " (external)", {}, s.log, shell);
+  }
+  try {
+    s.endpoint = wait_for_endpoint(c, s.port_file, timeout);
+  } catch (...) {
+    stop(c, std::chrono::milliseconds(0));
+    throw;
+  }
+  return c;
+}
+
+struct RunOptions {
+  std::string scene_path, out_dir, solid_command, fluid_command;
+  std::vector<std::string> overrides;
+  double timeout = 600;
+  bool resume = false, force = false;
+  int recover = -1;  // -1: 3 when checkpoints are on, else 0
+};
+
+int run(const RunOptions& o) {
+  auto log = fsi::logger("fsi");
+  const auto scene = fsi::Scene::load(o.scene_path, o.overrides);  // fails early on a bad file
+  const bool has_solid = scene.has("solid"), has_fluid = scene.has("fluid"), coupled = scene.has("coupling");
+  const fs::path out(o.out_dir), bin = self_dir();
+  fsi::prepare_output_dir(out, o.resume ? fsi::OutputMode::Resume : o.force ? fsi::OutputMode::Force
+                                                                           : fsi::OutputMode::Fresh);
+  std::vector<std::string> sets;
+  for (const auto& ov : o.overrides) sets.insert(sets.end(), {"--set", ov});
+
+  int code = 1;
+  std::string final_status, final_reason;  // set when the launcher has the last word
+  if (!coupled) {
+    // One solver alone.
+    Child main;
+    try {
+      if (o.resume) throw fsi::ConfigError("--resume: only coupled runs write checkpoints");
       if (has_solid == has_fluid)
-        throw fsi::ConfigError(scene_path + ": a scene without 'coupling' must have exactly one of 'solid' or 'fluid'");
+        throw fsi::ConfigError(o.scene_path + ": a scene without 'coupling' must have exactly one of 'solid' or 'fluid'");
       const std::string server = has_solid ? "solid_server" : "fluid_server";
-      std::vector<std::string> argv{(bin / server).string(), "--standalone", scene_path, "--out", out_dir};
+      std::vector<std::string> argv{(bin / server).string(), "--standalone", o.scene_path, "--out", o.out_dir};
       argv.insert(argv.end(), sets.begin(), sets.end());
-      log->info("scene '{}': {} alone", scene_path, server);
-      children.push_back(spawn(server, argv, ""));
-    } else {
-      if (!has_solid || !has_fluid) throw fsi::ConfigError(scene_path + ": a coupled scene needs 'solid' and 'fluid'");
-      const fs::path ports = out / ".ports";
-      fs::create_directories(ports);
-      std::map<std::string, std::string> endpoints;
-      for (const auto& [side, command] : {std::pair{std::string("solid"), solid_command}, {"fluid", fluid_command}}) {
-        const std::string server = side + "_server";
-        const fs::path port_file = ports / (side + ".port");
-        fs::remove(port_file);
-        const fs::path server_log = out / (server + ".log");
-        if (command.empty()) {
-          children.push_back(spawn(server, {(bin / server).string(), "--bind", "tcp://127.0.0.1:*", "--port-file",
-                                            port_file.string()},
-                                   server_log));
-        } else {
-          const std::string shell = fmt::format("exec {} --bind 'tcp://127.0.0.1:*' --port-file '{}'", command,
-                                                port_file.string());
-          children.push_back(spawn(server + " (external)", {}, server_log, shell));
+      log->info("scene '{}': {} alone", o.scene_path, server);
+      main = spawn(server, argv, "");
+      bool forwarded = false;
+      while (main.alive()) {
+        reap(main, false);
+        if (g_signal && !forwarded) kill(main.pid, g_signal), forwarded = true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      code = main.status;
+      if (code > 128 && code != 130) {
+        final_status = "failed";
+        final_reason = fmt::format("{} was killed by {} ({})", server, signal_name(code - 128), code - 128);
+        code = 1;
+      }
+    } catch (const std::exception& e) {
+      log->error("{}", e.what());
+      final_status = "failed";
+      final_reason = e.what();
+      code = 1;
+    }
+    stop(main, std::chrono::seconds(2));
+    if (g_signal && code != 0 && code != 2 && code != 130 && final_status.empty()) code = 130;
+    finalize_summary(out, scene, final_status.empty() ? (code == 130 ? "interrupted" : "failed") : final_status,
+                     final_reason.empty() ? "the run ended without a final summary" : final_reason,
+                     final_status.empty());
+    return code;
+  }
+
+  // Coupled: two servers and the coupler; with --recover, a server that dies or stops
+  // answering is started again with the same command and address and the run resumes
+  // from the last checkpoint.
+  const fs::path ports = out / ".ports";
+  std::vector<Server> servers;
+  std::vector<Child> children(2);  // solid, fluid
+  Child coupler;
+  int recover = o.recover;
+  try {
+    if (!has_solid || !has_fluid) throw fsi::ConfigError(o.scene_path + ": a coupled scene needs 'solid' and 'fluid'");
+    const int every = scene.section("time").get<int>("checkpoint_every", 0);
+    if (recover < 0) recover = every > 0 ? 3 : 0;
+    if (recover > 0 && every == 0)
+      log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
+    fs::create_directories(ports);
+    for (const auto& [side, command] : {std::pair{std::string("solid"), o.solid_command}, {"fluid", o.fluid_command}}) {
+      Server s{side, command, "", ports / (side + ".port"), out / (side + "_server.log")};
+      const std::size_t i = side == "solid" ? 0 : 1;
+      children[i] = start_server(s, bin, "tcp://127.0.0.1:*", std::chrono::seconds(30));
+      log->info("{} listening on {} (log: {})", children[i].name, s.endpoint, s.log.string());
+      servers.push_back(s);
+    }
+    int attempts = 0;
+    bool resume = o.resume;
+    while (true) {
+      std::vector<std::string> argv{(bin / "coupler").string(), o.scene_path, "--solid", servers[0].endpoint, "--fluid",
+                                    servers[1].endpoint, "--out", o.out_dir, "--timeout", fmt::format("{}", o.timeout),
+                                    "--out-ready"};
+      if (resume) argv.push_back("--resume");
+      if (resume && attempts > 0) argv.push_back("--resume-or-restart");
+      if (recover > 0) argv.push_back("--recoverable");
+      argv.insert(argv.end(), sets.begin(), sets.end());
+      coupler = spawn("coupler", argv, "");
+      bool forwarded = false;
+      while (coupler.alive()) {
+        reap(coupler, false);
+        if (g_signal && !forwarded) {
+          log->warn("{} received: stopping the coupler", signal_name(g_signal));
+          kill(coupler.pid, g_signal);
+          forwarded = true;
         }
-        endpoints[side] = wait_for_endpoint(children.back(), port_file, std::chrono::seconds(30));
-        log->info("{} listening on {} (log: {})", children.back().name, endpoints[side], server_log.string());
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
       }
-      std::vector<std::string> argv{(bin / "coupler").string(), scene_path, "--solid", endpoints["solid"], "--fluid",
-                                    endpoints["fluid"], "--out", out_dir, "--timeout", fmt::format("{}", timeout)};
-      argv.insert(argv.end(), sets.begin(), sets.end());
-      children.push_back(spawn("coupler", argv, ""));
-    }
-    // Wait for the main process (the last one) to finish; forward Ctrl-C.
-    Child& main = children.back();
-    bool forwarded = false;
-    while (main.alive()) {
-      reap(main, false);
-      if (g_signal && !forwarded) {
-        log->warn("signal received: stopping {}", main.name);
-        kill(main.pid, SIGINT);
-        forwarded = true;
+      code = coupler.status;
+      if (code != 75) break;
+      // A server died or stopped answering.
+      const auto summary = read_json(out / "summary.json");
+      const auto lost = summary.is_object() ? summary.value("lost_peer", nlohmann::json::object()) : nlohmann::json();
+      const std::string process = lost.value("process", std::string());
+      const std::size_t i = process == "solid_server" ? 0 : 1;
+      if (g_signal) {
+        code = 130;
+        final_status = "interrupted";
+        final_reason = fmt::format("{} received while recovering {}", signal_name(g_signal), process);
+        break;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (attempts >= recover) {
+        code = 1;
+        final_status = "failed";
+        final_reason = fmt::format("{} {} at step {}; gave up after {} recover{}", process,
+                                   lost.value("cause", std::string("failed")), lost.value("step", 0), attempts,
+                                   attempts == 1 ? "y" : "ies");
+        break;
+      }
+      ++attempts;
+      const auto t0 = std::chrono::steady_clock::now();
+      log->warn("{} {} at step {}: restarting it (recovery {} of {})", process, lost.value("cause", std::string("failed")),
+                lost.value("step", 0), attempts, recover);
+      reap(children[i], false);
+      if (children[i].alive()) {  // stopped or hung: it cannot be trusted any more
+        kill(-children[i].pid, SIGKILL);
+        kill(children[i].pid, SIGKILL);
+        reap(children[i], true);
+      }
+      children[i] = start_server(servers[i], bin, servers[i].endpoint, std::chrono::seconds(30));
+      const nlohmann::json checkpoint = newest_checkpoint(out);
+      const int from = checkpoint.is_object() ? checkpoint.value("step", 0) : 0;
+      const double restart_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double recompute = lost.value("wall_seconds", 0.0) -
+                               (checkpoint.is_object() ? checkpoint.value("wall_seconds", 0.0) : 0.0);
+      nlohmann::json j = summary.is_object() ? summary : nlohmann::json::object();
+      auto& recoveries = j["recoveries"];
+      if (!recoveries.is_array()) recoveries = nlohmann::json::array();
+      recoveries.push_back({{"step", lost.value("step", 0)},
+                            {"process", process},
+                            {"cause", lost.value("cause", std::string("unknown"))},
+                            {"resumed_from_step", from},
+                            {"seconds_lost", std::max(0.0, recompute) + restart_seconds}});
+      j.erase("lost_peer");
+      write_json_atomic(out / "summary.json", j);
+      log->info("{} listening again on {}; resuming from step {}", children[i].name, servers[i].endpoint, from);
+      resume = true;
     }
-    code = main.status;
+    if (code > 128 && code != 130) {
+      // The coupler itself died: say so at once, stop both servers together.
+      final_status = "failed";
+      final_reason = fmt::format("the coupler was killed by {} ({}); `fsi run ... --resume` continues from the last "
+                                 "checkpoint",
+                                 signal_name(code - 128), code - 128);
+      log->error("{}", final_reason);
+      stop_all({&children[0], &children[1]}, std::chrono::milliseconds(0), std::chrono::milliseconds(400));
+      code = 1;
+    }
     for (auto& c : children) {
       reap(c, false);
-      if (&c != &main && c.status > 0) log->error("{} exited with code {}; its log ({}):\n{}", c.name, c.status,
-                                                  c.log.string(), tail(c.log, 10));
+      if (c.status > 0 && c.status != 130 && final_status.empty())
+        log->error("{} exited with code {}; its log ({}):\n{}", c.name, c.status, c.log.string(), tail(c.log, 10));
     }
   } catch (const std::exception& e) {
     log->error("{}", e.what());
+    final_status = g_signal ? "interrupted" : "failed";
+    final_reason = e.what();
+    code = g_signal ? 130 : 1;
+  }
+  stop_all({&coupler, &children[0], &children[1]}, std::chrono::seconds(3));
+  fs::remove_all(ports);
+  if (final_status.empty() && code != 0 && code != 1 && code != 2 && code != 130) {
+    final_status = "failed";
+    final_reason = fmt::format("the coupler exited with code {}", code);
     code = 1;
   }
-  for (auto& c : children) stop(c, std::chrono::seconds(5));
-  if (g_signal && code == 0) code = 130;
+  finalize_summary(out, scene, final_status.empty() ? "failed" : final_status,
+                   final_reason.empty() ? "the coupler ended without a final summary" : final_reason,
+                   final_status.empty());
   return code;
 }
 
@@ -246,28 +462,44 @@ int main(int argc, char** argv) {
   CLI::App app{"fsi: partitioned fluid-structure interaction co-simulation"};
   app.require_subcommand(1);
   auto* run_cmd = app.add_subcommand("run", "run one scene, starting only the processes it needs");
-  std::string scene, out = "runs/latest", solid_command, fluid_command;
-  std::vector<std::string> overrides;
-  double timeout = 600;
-  run_cmd->add_option("scene", scene, "scene file (configs/*.yaml)")->required()->check(CLI::ExistingFile);
-  run_cmd->add_option("--out", out, "output folder (summary.json, probes.csv, iterations.csv, logs, vtk/)");
-  run_cmd->add_option("--set", overrides, "override any scene key: dotted.key=value (repeatable)");
-  run_cmd->add_option("--solid-command", solid_command,
+  RunOptions o;
+  o.out_dir = "runs/latest";
+  run_cmd->add_option("scene", o.scene_path, "scene file (configs/*.yaml)")->required()->check(CLI::ExistingFile);
+  run_cmd->add_option("--out", o.out_dir,
+                      "output folder (summary.json, probes.csv, iterations.csv, logs, vtk/, checkpoints/); "
+                      "refused when not empty, unless --resume or --force");
+  run_cmd->add_option("--set", o.overrides, "override any scene key: dotted.key=value (repeatable)");
+  run_cmd->add_option("--solid-command", o.solid_command,
                       "start this external solid instead of solid_server (gets --bind and --port-file)");
-  run_cmd->add_option("--fluid-command", fluid_command, "start this external fluid instead of fluid_server");
-  run_cmd->add_option("--timeout", timeout, "seconds the coupler waits for any single reply");
+  run_cmd->add_option("--fluid-command", o.fluid_command, "start this external fluid instead of fluid_server");
+  run_cmd->add_option("--timeout", o.timeout,
+                      "seconds the coupler waits for any single reply (a server that does not answer within it "
+                      "counts as failed; a dead one is noticed at once)");
+  run_cmd->add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
+  run_cmd->add_flag("--force", o.force, "replace the results of an earlier run in --out");
+  run_cmd->add_option("--recover", o.recover,
+                      "restart a server that dies or stops answering up to N times, resuming from the last "
+                      "checkpoint (default: 3 when time.checkpoint_every > 0, else 0)");
   auto* study_cmd = app.add_subcommand("study", "run a parameter study (tools/fsi_study.py run; docs/studies.md)");
   std::string study_file, study_out = "runs/study";
   int jobs = 0;
   study_cmd->add_option("study", study_file, "study file (studies/*.yaml)")->required()->check(CLI::ExistingFile);
   study_cmd->add_option("--out", study_out, "study folder (results.csv, results.json, runs/)");
   study_cmd->add_option("--jobs", jobs, "parallel runs (default: number of cores)");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;  // command-line errors exit 1, like every failed run
+  }
+  if (o.resume && o.force) {
+    fsi::logger("fsi")->error("--resume and --force exclude each other");
+    return 1;
+  }
   if (study_cmd->parsed()) return study(study_file, study_out, jobs);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
-    return run(scene, out, overrides, solid_command, fluid_command, timeout);
+    return run(o);
   } catch (const std::exception& e) {
     fsi::logger("fsi")->error("{}", e.what());
     return 1;

@@ -7,7 +7,7 @@ packages=(
   libprotobuf-dev protobuf-compiler libzmq3-dev cppzmq-dev
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libgtest-dev
   gmsh
-  python3 python3-zmq python3-protobuf python3-yaml python3-matplotlib
+  python3 python3-zmq python3-protobuf python3-yaml python3-matplotlib python3-psutil
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -680,7 +680,7 @@ class Runner:
         m = self.marker(spec)
         m["state"] = "running"
         write_json(d / "study_run.json", m)
-        cmd = [self.fsi, "run", str(self.study.scene), "--out", str(d)]
+        cmd = [self.fsi, "run", str(self.study.scene), "--out", str(d), "--force"]
         for s in spec["sets"]:
             cmd += ["--set", s]
         log = open(d / "fsi.log", "w")

@@ -41,6 +41,34 @@ nlohmann::json yaml_to_json(const YAML::Node& node) {
 
 }  // namespace
 
+void prepare_output_dir(const std::filesystem::path& out_dir, OutputMode mode) {
+  namespace fs = std::filesystem;
+  if (fs::exists(out_dir) && !fs::is_directory(out_dir))
+    throw std::runtime_error("--out '" + out_dir.string() + "' exists and is not a folder");
+  const bool empty = !fs::exists(out_dir) || fs::is_empty(out_dir);
+  if (!empty && mode == OutputMode::Fresh)
+    throw std::runtime_error("--out '" + out_dir.string() +
+                             "' is not empty: pass --resume to continue the run in it from its last checkpoint, "
+                             "or --force to replace its results");
+  if (!empty && mode == OutputMode::Force) {
+    for (const auto& e : fs::directory_iterator(out_dir)) {
+      const std::string name = e.path().filename().string();
+      const bool ours = name == "summary.json" || name == "summary.json.tmp" || name == "probes.csv" ||
+                        name == "iterations.csv" || name == "vtk" || name == "checkpoints" || name == ".ports" ||
+                        name == "solid_server.log" || name == "fluid_server.log" || name == "coupler.log";
+      if (ours) fs::remove_all(e.path());
+    }
+  }
+  fs::create_directories(out_dir);
+}
+
+std::size_t csv_rows(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::size_t lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  return lines > 0 ? lines - 1 : 0;
+}
+
 nlohmann::json scene_to_json(const Scene& scene) { return yaml_to_json(YAML::Load(YAML::Dump(scene.root_node()))); }
 
 RunReport::RunReport(std::filesystem::path out_dir, const Scene& scene, std::string runner)
@@ -67,6 +95,14 @@ void RunReport::write() const {
     out << data_.dump(2) << '\n';
   }
   std::filesystem::rename(tmp, out_dir_ / "summary.json");
+}
+
+ProbeTable ProbeTable::resume(std::filesystem::path path, std::size_t keep_rows) {
+  ProbeTable t(path);
+  t.csv_ = CsvWriter::resume(path, keep_rows);
+  const auto& header = t.csv_.header();
+  t.names_.assign(header.begin() + (header.empty() ? 0 : 1), header.end());
+  return t;
 }
 
 void ProbeTable::add(double time, const std::map<std::string, double>& probes) {

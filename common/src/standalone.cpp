@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
@@ -11,9 +13,16 @@
 namespace fsi {
 namespace {
 
+std::atomic<int> g_standalone_signal{0};
+extern "C" void on_standalone_signal(int sig) { g_standalone_signal = sig; }
+
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+
+struct Interrupted {
+  std::string reason;
+};
 
 template <class Model, class SetupFn, class StepFn>
 int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::filesystem::path& out_dir,
@@ -23,13 +32,20 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
   RunReport report(out_dir, scene, runner);
   const double start = now_seconds();
   int steps_done = 0;
+  std::signal(SIGINT, on_standalone_signal);
+  std::signal(SIGTERM, on_standalone_signal);
   try {
     scene.name();
     const TimeSettings time = read_time(scene);
+    if (time.checkpoint_every > 0)
+      log->warn("time.checkpoint_every: checkpoints are written by coupled runs only; this {} run writes none", section);
     setup_fn(time);
     ProbeTable probes(out_dir / "probes.csv");
     Progress progress(runner, time.steps);
     for (int n = 1; n <= time.steps; ++n) {
+      if (g_standalone_signal)
+        throw Interrupted{fmt::format("interrupted by {} before step {}",
+                                      g_standalone_signal == SIGINT ? "SIGINT" : "SIGTERM", n)};
       StepInfo info{n * time.dt, time.dt, n, 0};
       const double t0 = now_seconds();
       auto values = step_fn(info);
@@ -53,6 +69,8 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     report.set_status("completed");
     report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
         if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
+  } catch (const Interrupted& e) {
+    report.set_status("interrupted", e.reason);
   } catch (const ConfigError& e) {
     report.set_status("failed", std::string("configuration: ") + e.what());
   } catch (const SolverError& e) {
@@ -67,7 +85,7 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
   const std::string status = report.data()["status"];
   if (status != "completed") {
     log->error("{}: {}", status, report.data()["reason"].get<std::string>());
-    return 1;
+    return status == "diverged" ? 2 : status == "interrupted" ? 130 : 1;
   }
   log->info("completed {} steps in {:.2f} s; results in {}", steps_done, now_seconds() - start, out_dir.string());
   return 0;
@@ -84,6 +102,10 @@ TimeSettings read_time(const Scene& scene) {
   if (!(s.dt > 0)) t.fail("dt", "must be positive");
   if (!(s.end > 0)) t.fail("end", "must be positive");
   if (s.output_every < 0) t.fail("output_every", "must be >= 0");
+  s.checkpoint_every = t.get<int>("checkpoint_every", 0);
+  s.checkpoint_keep = t.get<int>("checkpoint_keep", 2);
+  if (s.checkpoint_every < 0) t.fail("checkpoint_every", "must be >= 0 (0 = no checkpoints)");
+  if (s.checkpoint_keep < 1) t.fail("checkpoint_keep", "must be >= 1");
   s.steps = static_cast<int>(std::llround(s.end / s.dt));
   if (s.steps < 1) t.fail("end", "is shorter than one time step");
   return s;

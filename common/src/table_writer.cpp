@@ -2,14 +2,49 @@
 
 #include <fmt/format.h>
 
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace fsi {
 
 CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns)
-    : out_(path), columns_(columns.size()), path_(path) {
+    : out_(path), columns_(columns.size()), path_(path), header_(columns) {
   if (!out_) throw std::runtime_error("cannot write '" + path.string() + "'");
   row(columns);
+}
+
+CsvWriter CsvWriter::resume(const std::filesystem::path& path, std::size_t keep_rows,
+                            const std::vector<std::string>& columns) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("cannot resume '{}': it does not exist", path.string()));
+  std::string header_line;
+  if (!std::getline(in, header_line))
+    throw std::runtime_error(fmt::format("cannot resume '{}': it has no header", path.string()));
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(header_line);
+    for (std::string c; std::getline(ss, c, ',');) header.push_back(c);
+  }
+  if (!columns.empty() && header != columns)
+    throw std::runtime_error(fmt::format("cannot resume '{}': its columns differ from this run's", path.string()));
+  std::size_t rows = 0;
+  std::streamoff keep_bytes = static_cast<std::streamoff>(header_line.size() + 1);
+  for (std::string line; rows < keep_rows && std::getline(in, line); ++rows)
+    keep_bytes += static_cast<std::streamoff>(line.size() + 1);
+  if (rows < keep_rows)
+    throw std::runtime_error(fmt::format("cannot resume '{}': it has {} data rows, the checkpoint needs {}",
+                                         path.string(), rows, keep_rows));
+  in.close();
+  std::filesystem::resize_file(path, static_cast<std::uintmax_t>(keep_bytes));
+  CsvWriter w;
+  w.out_.open(path, std::ios::app);
+  if (!w.out_) throw std::runtime_error("cannot write '" + path.string() + "'");
+  w.columns_ = header.size();
+  w.path_ = path;
+  w.header_ = header;
+  return w;
 }
 
 void CsvWriter::row(const std::vector<std::string>& values) {

@@ -27,6 +27,38 @@ void InterfaceAccelerator::end_step() {
   }
 }
 
+void InterfaceAccelerator::save(StateArchive& state, const std::string& prefix) const {
+  state.put(prefix + "last_omega", last_omega_);
+  state.put(prefix + "reused_steps", static_cast<std::int64_t>(v_old_.size()));
+  for (std::size_t s = 0; s < v_old_.size(); ++s) {
+    const std::string p = prefix + "step" + std::to_string(s) + ".";
+    state.put(p + "columns", static_cast<std::int64_t>(v_old_[s].size()));
+    for (std::size_t i = 0; i < v_old_[s].size(); ++i) {
+      state.put(p + "v" + std::to_string(i), v_old_[s][i]);
+      state.put(p + "w" + std::to_string(i), w_old_[s][i]);
+    }
+  }
+}
+
+void InterfaceAccelerator::load(const StateArchive& state, const std::string& prefix) {
+  begin_step();
+  last_omega_ = state.real(prefix + "last_omega");
+  v_old_.clear();
+  w_old_.clear();
+  const auto steps = state.integer(prefix + "reused_steps");
+  for (std::int64_t s = 0; s < steps; ++s) {
+    const std::string p = prefix + "step" + std::to_string(s) + ".";
+    std::deque<Eigen::VectorXd> v, w;
+    const auto columns = state.integer(p + "columns");
+    for (std::int64_t i = 0; i < columns; ++i) {
+      v.push_back(state.vector(p + "v" + std::to_string(i)));
+      w.push_back(state.vector(p + "w" + std::to_string(i)));
+    }
+    v_old_.push_back(std::move(v));
+    w_old_.push_back(std::move(w));
+  }
+}
+
 Eigen::VectorXd InterfaceAccelerator::update(const Eigen::VectorXd& x, const Eigen::VectorXd& r) {
   ++k_;
   last_columns_ = 0;

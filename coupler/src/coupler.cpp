@@ -9,7 +9,12 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/table_writer.hpp"
+#include "fsi/common/state.hpp"
 #include "fsi/coupling/acceleration.hpp"
+#include "fsi/coupling/checkpoint.hpp"
+
+#include <optional>
+#include <tuple>
 
 namespace fsi::coupling {
 namespace {
@@ -111,14 +116,79 @@ RunOutcome Coupler::run(RunReport& report) {
               to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
               settings_.tolerance, ns, fluid_interface.nodes());
 
-    // 2. Initial state and the predictor's F_0 = -F*(initial fluid state).
+    // 2. Initial state: the newest checkpoint (resume), or the scene's initial state and the
+    //    predictor's F_0 = -F*(initial fluid state).
+    const bool checkpoints = time.checkpoint_every > 0;
+    if (checkpoints || resume_)
+      for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_checkpoint(), solid_.name()},
+                                          std::tuple{"fluid", fluid_.supports_checkpoint(), fluid_.name()}})
+        if (!ok)
+          throw Stop{"failed", fmt::format("{} needs checkpoints, which the {} '{}' does not support",
+                                           resume_ ? "--resume" : "time.checkpoint_every", side, who)};
     Eigen::VectorXd d_s = solid_interface_.initial_displacement.size() == 2 * ns
                               ? solid_interface_.initial_displacement
                               : Eigen::VectorXd::Zero(2 * ns);
     Eigen::VectorXd v_s = solid_interface_.initial_velocity.size() == 2 * ns ? solid_interface_.initial_velocity
                                                                               : Eigen::VectorXd::Zero(2 * ns);
     Eigen::VectorXd force_n, force_nm1;
-    {
+    // Work done across the interface, on each side: by the load the solid was actually
+    // given, and by the fluid's traction on the fluid's interface motion. With the
+    // transpose mapping they differ only by the partitioned scheme's lag and relaxation.
+    double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0;
+    Eigen::VectorXd d_s_prev = d_s, d_f_prev = map_.to_fluid(d_s);
+    InterfaceAccelerator accelerator(settings_);
+    const nlohmann::json parameters = scene_to_json(scene_);
+    CheckpointStore store(out_dir_ / "checkpoints", time.checkpoint_keep);
+    std::optional<CheckpointStore::Loaded> restart;
+    double wall_before = 0;  // wall seconds of the run's earlier segments (resumed runs)
+    if (resume_) {
+      std::vector<std::string> skipped;
+      restart = store.newest(&skipped);
+      for (const auto& why : skipped) log->warn("skipping checkpoint {}", why);
+      if (!restart && !allow_fresh_start_)
+        throw Stop{"failed", fmt::format("--resume: no complete checkpoint in {}{}", (out_dir_ / "checkpoints").string(),
+                                         skipped.empty() ? std::string() : " (" + skipped.front() + ")")};
+      if (!restart) log->warn("no complete checkpoint yet: starting again from step 0");
+    }
+    if (restart) {
+      const int step = restart->step;
+      const auto diffs = parameter_differences(restart->manifest.value("parameters", nlohmann::json::object()), parameters);
+      if (!diffs.empty()) {
+        std::string list;
+        for (const auto& d : diffs) list += "\n  " + d;
+        throw Stop{"failed", fmt::format("--resume: the scene differs from the one checkpoint {} was written with "
+                                         "({} key(s)):{}",
+                                         restart->dir.string(), diffs.size(), list)};
+      }
+      for (const char* part : {"solid", "fluid", "coupler"})
+        if (!restart->parts.count(part))
+          throw Stop{"failed", fmt::format("checkpoint {} has no '{}' part", restart->dir.string(), part)};
+      log->info("resuming from the checkpoint of step {} (t = {}) in {}", step, restart->time, restart->dir.string());
+      {
+        Timer t(solid_time);
+        solid_.load_checkpoint(step, restart->time, restart->parts.at("solid"));
+      }
+      {
+        Timer t(fluid_time);
+        fluid_.load_checkpoint(step, restart->time, restart->parts.at("fluid"));
+      }
+      const StateArchive c = StateArchive::parse(restart->parts.at("coupler"), "coupler checkpoint of step " +
+                                                                                    std::to_string(step));
+      if (c.integer("step") != step)
+        throw Stop{"failed", fmt::format("checkpoint {}: coupler part is of step {}", restart->dir.string(), c.integer("step"))};
+      force_n = c.vector("force_n", 2 * ns);
+      force_nm1 = c.vector("force_nm1", 2 * ns);
+      d_s_prev = c.vector("d_s_prev", 2 * ns);
+      d_f_prev = c.vector("d_f_prev", d_f_prev.size());
+      work_solid = c.real("work_solid");
+      work_fluid = c.real("work_fluid");
+      work_fluid_on_solid = c.real("work_fluid_on_solid");
+      out.iterations = static_cast<long>(c.integer("iterations"));
+      accelerator.load(c, "accelerator.");
+      wall_before = restart->manifest.value("wall_seconds", 0.0);
+      out.steps = step;
+      out.resumed_from = step;
+    } else {
       FluidLoads loads;
       {
         Timer t(fluid_time);
@@ -126,21 +196,56 @@ RunOutcome Coupler::run(RunReport& report) {
       }
       Timer t(coupler_time);
       force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s);
+      force_nm1 = force_n;
     }
-    force_nm1 = force_n;
+    if (checkpoints)
+      data["checkpoints"] = {{"every", time.checkpoint_every}, {"keep", time.checkpoint_keep}, {"written", 0},
+                             {"seconds", 0.0}, {"folder", (out_dir_ / "checkpoints").string()}};
+    if (restart) data["resumed_from_step"] = restart->step;
+    data["wall_time_earlier_segments"] = wall_before;
 
     // 3. Time loop.
-    // Work done across the interface, on each side: by the load the solid was actually
-    // given, and by the fluid's traction on the fluid's interface motion. With the
-    // transpose mapping they differ only by the partitioned scheme's lag and relaxation.
-    double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0;
-    Eigen::VectorXd d_s_prev = d_s, d_f_prev = map_.to_fluid(d_s);
-    ProbeTable probes(out_dir_ / "probes.csv");
-    CsvWriter iterations(out_dir_ / "iterations.csv",
-                         {"step", "time", "iteration", "residual", "force_norm", "solid_newton", "fluid_iterations"});
+    const std::vector<std::string> iteration_columns{"step",        "time",         "iteration",       "residual",
+                                                     "force_norm",  "solid_newton", "fluid_iterations"};
+    ProbeTable probes = restart ? ProbeTable::resume(out_dir_ / "probes.csv", static_cast<std::size_t>(restart->step))
+                                : ProbeTable(out_dir_ / "probes.csv");
+    CsvWriter iterations =
+        restart ? CsvWriter::resume(out_dir_ / "iterations.csv", static_cast<std::size_t>(out.iterations), iteration_columns)
+                : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
     Progress progress("coupler", time.steps);
-    InterfaceAccelerator accelerator(settings_);
-    for (int n = 1; n <= time.steps; ++n) {
+    const double segment_start = now();
+    auto save_checkpoint = [&](int n, double t_np1) {
+      Timer t(times_.checkpoint);
+      std::map<std::string, std::string> parts;
+      parts["solid"] = solid_.save_checkpoint(n, t_np1);
+      parts["fluid"] = fluid_.save_checkpoint(n, t_np1);
+      StateArchive c;
+      c.put("step", static_cast<std::int64_t>(n));
+      c.put("force_n", force_n);
+      c.put("force_nm1", force_nm1);
+      c.put("d_s_prev", d_s_prev);
+      c.put("d_f_prev", d_f_prev);
+      c.put("work_solid", work_solid);
+      c.put("work_fluid", work_fluid);
+      c.put("work_fluid_on_solid", work_fluid_on_solid);
+      c.put("iterations", static_cast<std::int64_t>(out.iterations));
+      accelerator.save(c, "accelerator.");
+      parts["coupler"] = c.serialize();
+      nlohmann::json manifest = {{"scene", data.value("scene", std::string())},
+                                 {"scene_file", scene_.origin()},
+                                 {"overrides", scene_.overrides()},
+                                 {"parameters", parameters},
+                                 {"iterations", out.iterations},
+                                 {"wall_seconds", wall_before + (now() - segment_start)}};
+      const auto written = store.write(n, t_np1, manifest, parts);
+      auto& info = data["checkpoints"];
+      info["written"] = info.value("written", 0) + 1;
+      info["last_step"] = n;
+      info["last_bytes"] = written.bytes;
+      info["parts_bytes"] = {{"solid", parts["solid"].size()}, {"fluid", parts["fluid"].size()},
+                             {"coupler", parts["coupler"].size()}};
+    };
+    for (int n = out.steps + 1; n <= time.steps; ++n) {
       const double t_np1 = n * time.dt;
       Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * force_n - force_nm1)
                                                                                : force_n;
@@ -152,7 +257,8 @@ RunOutcome Coupler::run(RunReport& report) {
       FluidLoads loads_last;
       Eigen::VectorXd force_applied, d_f_last;
       for (; k <= settings_.max_iterations; ++k) {
-        if (interrupt_flag()) throw Stop{"failed", fmt::format("interrupted at step {} iteration {}", n, k)};
+        if (interrupt_flag())
+          throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
         const StepInfo info{t_np1, time.dt, n, k};
         SolidStepResult s;
         {
@@ -257,6 +363,10 @@ RunOutcome Coupler::run(RunReport& report) {
       force_nm1 = force_n;
       force_n = force;
       out.steps = n;
+      if (checkpoints && n % time.checkpoint_every == 0 && n < time.steps) {
+        save_checkpoint(n, t_np1);
+        data["checkpoints"]["seconds"] = times_.checkpoint;
+      }
       times_.total = now() - start;
       if (on_step) on_step(out);
       progress.update(n, t_np1, fmt::format("iterations {} residual {:.2e}", used, residual));

@@ -18,7 +18,18 @@ fsi::v1::Reply ProtocolClient::call(fsi::v1::Request request) {
   request.set_protocol_version(kProtocolVersion);
   request.set_sequence(++sequence_);
   const std::string what = body_name(request);
-  client_.send(request.SerializeAsString(), timeout_);
+  try {
+    client_.send(request.SerializeAsString(), timeout_);
+  } catch (const transport::TimeoutError&) {
+    failure_ = "timeout";
+    throw;
+  } catch (const transport::PeerLostError&) {
+    failure_ = "died";
+    throw;
+  } catch (const transport::TransportError&) {
+    failure_ = "transport";
+    throw;
+  }
   fsi::v1::Reply reply;
   while (true) {
     const auto left = timeout_ - std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -27,10 +38,13 @@ fsi::v1::Reply ProtocolClient::call(fsi::v1::Request request) {
     try {
       bytes = client_.receive(std::max(left, std::chrono::milliseconds(1)));
     } catch (const transport::TimeoutError& e) {
+      failure_ = "timeout";
       throw transport::TimeoutError(fmt::format("{} (request '{}', sequence {})", e.what(), what, sequence_));
     } catch (const transport::PeerLostError& e) {
+      failure_ = "died";
       throw transport::PeerLostError(fmt::format("{} (request '{}', sequence {})", e.what(), what, sequence_));
     } catch (const transport::TransportError& e) {
+      failure_ = "transport";
       throw transport::TransportError(fmt::format("{} (request '{}', sequence {})", e.what(), what, sequence_));
     }
     if (!reply.ParseFromString(bytes))

@@ -21,7 +21,11 @@ int server_main(int argc, char** argv, const ServerProgram& program) {
   app.add_option("--standalone", scene_path, "run the scene's " + program.kind + " alone (no coupler)");
   app.add_option("--out", out_dir, "output folder for --standalone");
   app.add_option("--set", overrides, "override a scene key: dotted.key=value (with --standalone)");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;  // command-line errors exit 1
+  }
 
   // 2. Run: standalone, or serve.
   try {

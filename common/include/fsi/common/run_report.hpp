@@ -15,6 +15,15 @@
 
 namespace fsi {
 
+// How a runner treats an --out folder that is not empty.
+enum class OutputMode { Fresh, Force, Resume };
+// Fresh: refuses a folder that exists and is not empty (naming --resume and --force);
+// Force: removes the files a run writes (summary, tables, logs, vtk/, checkpoints/) first;
+// Resume: keeps everything. Creates the folder. Throws std::runtime_error.
+void prepare_output_dir(const std::filesystem::path& out_dir, OutputMode mode);
+// Rows of a CSV table after its header (0 if there is no file).
+std::size_t csv_rows(const std::filesystem::path& path);
+
 // The scene (after --set overrides) as JSON: numbers stay numbers.
 nlohmann::json scene_to_json(const Scene& scene);
 
@@ -34,6 +43,8 @@ class RunReport {
 class ProbeTable {
  public:
   explicit ProbeTable(std::filesystem::path path) : path_(std::move(path)) {}
+  // Continues the table of a resumed run after its first `keep_rows` rows.
+  static ProbeTable resume(std::filesystem::path path, std::size_t keep_rows);
   // Columns are fixed by the first call: `time` then the sorted probe names.
   void add(double time, const std::map<std::string, double>& probes);
 

@@ -27,7 +27,8 @@ std::unique_ptr<Model> make_model(const std::function<std::unique_ptr<Model>(con
 
 // Both build the model named by `<section>.model`, configure it (unknown keys anywhere in
 // the scene are an error), run every step with a zero interface load, and return the
-// process exit code (0 completed, 1 failed/diverged) after writing the summary.
+// process exit code (0 completed, 2 diverged, 1 failed, 130 interrupted by SIGINT/SIGTERM)
+// after writing the summary.
 int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir);
 int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir);
 
@@ -37,6 +38,8 @@ struct TimeSettings {
   double end = 0;
   int steps = 0;          // round(end / dt)
   int output_every = 0;   // write VTK every N steps (0 = never)
+  int checkpoint_every = 0;  // coupled runs: a checkpoint every N accepted steps (0 = off)
+  int checkpoint_keep = 2;   // the newest K complete checkpoints are kept
 };
 TimeSettings read_time(const Scene& scene);
 

@@ -12,9 +12,15 @@ class CsvWriter {
  public:
   CsvWriter() = default;
   CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns);
+  // Continues an existing table (a resumed run): keeps its header and its first
+  // `keep_rows` data rows, drops the rest, appends from there. Throws naming the file when
+  // it has fewer rows than that or its header differs from `columns` (when not empty).
+  static CsvWriter resume(const std::filesystem::path& path, std::size_t keep_rows,
+                          const std::vector<std::string>& columns = {});
   CsvWriter(CsvWriter&&) = default;
   CsvWriter& operator=(CsvWriter&&) = default;
   bool is_open() const { return out_.is_open(); }
+  const std::vector<std::string>& header() const { return header_; }
   std::size_t columns() const { return columns_; }
   // Writes one row; throws std::invalid_argument if its size differs from the header's.
   void row(const std::vector<double>& values);
@@ -24,6 +30,7 @@ class CsvWriter {
   std::ofstream out_;
   std::size_t columns_ = 0;
   std::filesystem::path path_;
+  std::vector<std::string> header_;
 };
 
 }  // namespace fsi

@@ -12,6 +12,7 @@
 
 #include <deque>
 
+#include "fsi/common/state.hpp"
 #include "fsi/coupling/settings.hpp"
 
 namespace fsi::coupling {
@@ -29,6 +30,10 @@ class InterfaceAccelerator {
   double last_omega() const { return last_omega_; }
   // Secant pairs used by the last quasi-Newton update (after filtering).
   int last_columns() const { return last_columns_; }
+  // What carries over from one step to the next (the reused secant pairs, the last factor),
+  // for checkpoints: entries named "<prefix>...". Call between steps.
+  void save(StateArchive& state, const std::string& prefix) const;
+  void load(const StateArchive& state, const std::string& prefix);
 
  private:
   Eigen::VectorXd quasi_newton(const Eigen::VectorXd& x, const Eigen::VectorXd& r);

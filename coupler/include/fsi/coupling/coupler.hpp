@@ -12,6 +12,11 @@
 //     F^(k+1) = -beta F* + (1 - beta) F^(k)
 //   accept both; F_{n+1} = F^(k+1)
 //
+// Checkpoints (time.checkpoint_every: N): after every N-th accepted step the coupler saves
+// the state of both solvers and its own (F_n, F_{n-1}, the accelerator's reused secant
+// pairs, the work accumulators, counters) under OUT/checkpoints/ (checkpoint.hpp); a
+// resumed run continues from the newest one and writes the same probes.csv, byte for byte.
+//
 // Usage: Coupler c(solid, fluid, scene, out_dir); RunOutcome r = c.run();
 // The models may be in-process (tests) or remote proxies (protocol/remote.hpp).
 #include <Eigen/Core>
@@ -29,20 +34,31 @@
 namespace fsi::coupling {
 
 struct RunOutcome {
-  std::string status = "running";  // completed / diverged / failed
+  std::string status = "running";  // completed / diverged / failed / interrupted
   std::string reason;
   int steps = 0;
   long iterations = 0;
-  int exit_code() const { return status == "completed" ? 0 : status == "diverged" ? 2 : 1; }
+  int resumed_from = -1;           // the checkpoint's step when resumed
+  int exit_code() const {
+    return status == "completed" ? 0 : status == "diverged" ? 2 : status == "interrupted" ? 130 : 1;
+  }
 };
 
 struct CouplerTimes {
   double total = 0, solid = 0, fluid = 0, coupler = 0;  // wall seconds
+  double checkpoint = 0;                                // saving checkpoints (all three parts)
 };
 
 class Coupler {
  public:
   Coupler(SolidModel& solid, FluidModel& fluid, const Scene& scene, std::filesystem::path out_dir);
+  // Continue from the newest complete checkpoint in OUT/checkpoints (resume), refusing when
+  // the scene's parameters differ; with `allow_fresh_start`, a folder without one starts at
+  // step 0 instead of failing (automatic recovery before the first checkpoint).
+  void set_resume(bool resume, bool allow_fresh_start = false) {
+    resume_ = resume;
+    allow_fresh_start_ = allow_fresh_start;
+  }
   // Runs the whole scene. Never throws for a run-time failure: the outcome says why.
   // Writes probes.csv and iterations.csv row by row; fills `report` (summary.json).
   RunOutcome run(RunReport& report);
@@ -63,6 +79,8 @@ class Coupler {
   InterfaceMeshData solid_interface_;
   InterfaceMap map_;
   CouplerTimes times_;
+  bool resume_ = false;
+  bool allow_fresh_start_ = false;
 };
 
 }  // namespace fsi::coupling

@@ -37,8 +37,12 @@ class ProtocolClient {
   double wall_seconds() const { return wall_seconds_; }
   double server_compute_seconds() const { return compute_seconds_; }
   std::uint64_t calls() const { return sequence_; }
+  // How the connection failed, if it did: "" (it did not), "died" (the peer's connection
+  // dropped), "timeout" (no reply within the timeout) or "transport" (another error).
+  const std::string& failure() const { return failure_; }
 
  private:
+  std::string failure_;
   transport::Client client_;
   std::string peer_name_;
   std::chrono::milliseconds timeout_;
