@@ -149,9 +149,10 @@ std::string StateArchive::serialize() const {
 }
 
 StateArchive StateArchive::parse(const std::string& bytes, const std::string& where) {
+  if (bytes.compare(0, sizeof kMagic, std::string(kMagic, sizeof kMagic)) != 0)
+    throw StateError(fmt::format("{}: not a solver state (no FSISTATE header; {} bytes)", where, bytes.size()));
   Reader in(bytes, where);
-  if (in.read_bytes(sizeof kMagic, "the header") != std::string(kMagic, sizeof kMagic))
-    throw StateError(where + ": not a solver state (no FSISTATE header)");
+  in.read_bytes(sizeof kMagic, "the header");
   const auto version = in.read<std::uint32_t>("the format version");
   if (version != kFormatVersion)
     throw StateError(fmt::format("{}: state format version {}, this build reads version {}", where, version,
