@@ -49,7 +49,8 @@ Scene scene_from(const fsi::v1::Configure& c) {
 
 // The requests a solid and a fluid service answer the same way. Returns false for others.
 template <class Model>
-bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop, Model* model, double dt) {
+bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop, Model* model, double dt,
+                   const std::string& not_configured) {
   using R = fsi::v1::Request;
   const auto body = request.body_case();
   if (body == R::kStop) {
@@ -61,7 +62,7 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
       body != R::kLoadCheckpoint)
     return false;
   if (!model)
-    throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, fmt::format("'{}' before 'configure'", body_name(request)));
+    throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, not_configured);
   if (body == R::kGetInterface) {
     interface_to_proto(model->interface(), reply.mutable_interface());
   } else if (body == R::kAcceptStep) {
@@ -128,8 +129,15 @@ fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop) {
   } catch (const std::exception& e) {
     set_error(reply, fsi::v1::Error::INTERNAL, e.what());
   }
+  if (request.body_case() == fsi::v1::Request::kConfigure)
+    configure_failure_ = reply.has_error() ? reply.error().message() : std::string();
   reply.set_compute_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return reply;
+}
+
+std::string Service::before_configure(const std::string& request) const {
+  if (configure_failure_.empty()) return fmt::format("'{}' before 'configure'", request);
+  return fmt::format("'{}' on an unconfigured server: the last 'configure' failed ({})", request, configure_failure_);
 }
 
 std::string Service::handle_bytes(const std::string& bytes, bool& stop) {
@@ -150,10 +158,9 @@ SolidService::SolidService(SolidFactory factory, std::string server_name)
 
 void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
   using R = fsi::v1::Request;
-  if (handle_shared(request, reply, stop, model_.get(), dt_)) return;
+  if (handle_shared(request, reply, stop, model_.get(), dt_, before_configure(body_name(request)))) return;
   auto need_model = [&](const char* what) {
-    if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE,
-                                   fmt::format("'{}' before 'configure'", what));
+    if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, before_configure(what));
   };
   switch (request.body_case()) {
     case R::kHello: {
@@ -168,8 +175,15 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     }
     case R::kConfigure: {
       const auto& c = request.configure();
+      model_.reset();  // a failed Configure leaves the server unconfigured, not with the old model
+      interface_nodes_ = 0;
       if (!(c.dt() > 0) || !std::isfinite(c.dt()))
         throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
+      if (!std::isfinite(c.interface_damping()) || c.interface_damping() < 0)
+        throw std::invalid_argument(
+            fmt::format("configure: interface_damping must be finite and >= 0, got {}", c.interface_damping()));
+      if (!std::isfinite(c.end_time()) || c.end_time() < 0)
+        throw std::invalid_argument(fmt::format("configure: end_time must be finite and >= 0, got {}", c.end_time()));
       const Scene scene = scene_from(c);
       const auto section = scene.section(c.section().empty() ? "solid" : c.section());
       auto model = make_model(factory_, section, "solid");
@@ -211,10 +225,9 @@ FluidService::FluidService(FluidFactory factory, std::string server_name)
 
 void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
   using R = fsi::v1::Request;
-  if (handle_shared(request, reply, stop, model_.get(), 0.0)) return;
+  if (handle_shared(request, reply, stop, model_.get(), 0.0, before_configure(body_name(request)))) return;
   auto need_model = [&](const char* what) {
-    if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE,
-                                   fmt::format("'{}' before 'configure'", what));
+    if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, before_configure(what));
   };
   auto loads_reply = [&](const FluidLoads& loads) {
     require_finite(loads.traction_force, "fluid step (traction force)");
@@ -236,8 +249,17 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     }
     case R::kConfigure: {
       const auto& c = request.configure();
+      model_.reset();  // a failed Configure leaves the server unconfigured, not with the old model
+      interface_nodes_ = 0;
       if (!(c.dt() > 0) || !std::isfinite(c.dt()))
         throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
+      if (!std::isfinite(c.nitsche_penalty()) || c.nitsche_penalty() < 0)
+        throw std::invalid_argument(
+            fmt::format("configure: nitsche_penalty must be finite and >= 0, got {}", c.nitsche_penalty()));
+      if (!std::isfinite(c.nitsche_symmetry()))
+        throw std::invalid_argument(fmt::format("configure: nitsche_symmetry must be finite, got {}", c.nitsche_symmetry()));
+      if (!std::isfinite(c.end_time()) || c.end_time() < 0)
+        throw std::invalid_argument(fmt::format("configure: end_time must be finite and >= 0, got {}", c.end_time()));
       const Scene scene = scene_from(c);
       const auto section = scene.section(c.section().empty() ? "fluid" : c.section());
       auto model = make_model(factory_, section, "fluid");
@@ -286,6 +308,15 @@ int run_server(Service& service, const std::string& endpoint, const std::string&
     std::filesystem::rename(tmp, port_file);
   }
   log->info("listening on {}", bound);
+  server.set_frame_error_handler([](std::size_t frames) {
+    fsi::v1::Reply reply;
+    reply.set_protocol_version(kProtocolVersion);
+    set_error(reply, fsi::v1::Error::MALFORMED,
+              fmt::format("message has {} frames after the envelope, expected exactly 1 (one serialised "
+                          "fsi.v1.Request)",
+                          frames));
+    return reply.SerializeAsString();
+  });
   const auto idle = std::chrono::milliseconds(static_cast<long>(idle_timeout_seconds * 1000));
   const bool clean = server.serve(
       [&](const std::string& bytes, bool& stop) {

@@ -139,6 +139,56 @@ def bad_messages(env):
     assert server.wait(timeout=5) == 0
 
 
+def strict_protocol(env):
+    """Exactly one frame after the envelope; a failed Configure leaves the server
+    unconfigured (and the next request is told why); non-finite or negative Configure
+    numbers are refused naming the field."""
+    from fsi.v1 import coupling_pb2 as pb
+    server, endpoint = env.start_server("solid")
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.setsockopt(zmq.RCVTIMEO, 5000)
+    sock.connect(endpoint)
+
+    def call(*frames):
+        sock.send_multipart([b"", *[f if isinstance(f, bytes) else f.SerializeToString() for f in frames]])
+        parts = sock.recv_multipart()
+        assert parts[0] == b"" and len(parts) == 2, parts
+        reply = pb.Reply()
+        reply.ParseFromString(parts[1])
+        return reply
+
+    def expect_error(reply, code, text):
+        assert reply.WhichOneof("body") == "error" and reply.error.code == code, reply
+        assert text in reply.error.message, reply.error.message
+        print(f"  {pb.Error.Code.Name(code)}: {reply.error.message}")
+
+    hello = pb.Request(protocol_version=1, sequence=1, hello=pb.Hello(client_name="t"))
+    expect_error(call(hello, b"extra"), pb.Error.MALFORMED, "2 frames after the envelope, expected exactly 1")
+    expect_error(call(hello, hello), pb.Error.MALFORMED, "2 frames after the envelope")
+    assert call(hello).hello.kind == pb.SERVER_KIND_SOLID
+    with open(env.config("sdof_model.yaml")) as f:
+        text = f.read()
+
+    def configure(seq, **kw):
+        args = dict(dt=0.02, end_time=1, scene_text=text, scene_path="sdof_model.yaml", section="solid")
+        args.update(kw)
+        c = pb.Configure(**args)
+        return pb.Request(protocol_version=1, sequence=seq, configure=c)
+
+    assert call(configure(2)).configure.interface_nodes == 1
+    for seq, (field, value) in enumerate((("interface_damping", float("nan")), ("interface_damping", -1.0),
+                                          ("end_time", float("inf"))), start=3):
+        expect_error(call(configure(seq, **{field: value})), pb.Error.INVALID_ARGUMENT, field)
+    step = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[1.0, 0.0])
+    expect_error(call(pb.Request(protocol_version=1, sequence=9, solve_step=step)), pb.Error.BAD_SEQUENCE,
+                 "the last 'configure' failed (configure: end_time must be finite")
+    assert call(configure(10)).configure.interface_nodes == 1
+    assert call(pb.Request(protocol_version=1, sequence=11, solve_step=step)).WhichOneof("body") == "solid_step"
+    assert call(pb.Request(protocol_version=1, sequence=12, stop=pb.Stop(reason="done"))).WhichOneof("body") == "stop"
+    assert server.wait(timeout=5) == 0
+
+
 def added_mass(env):
     """Pure added mass over loopback: converges below the closed-form limit of beta and is
     reported as diverged above it, for Algorithm 1 and Algorithm 2 at several gamma."""
@@ -201,5 +251,5 @@ def interrupt(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, added_mass, config_errors,
-                                  interrupt)})
+    main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, added_mass,
+                                  config_errors, interrupt)})

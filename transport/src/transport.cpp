@@ -153,13 +153,26 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     }
     last_activity = std::chrono::steady_clock::now();
     if (frames.size() < 2) continue;  // no identity: cannot answer
-    // Envelope = every frame up to and including the empty delimiter (if present).
-    std::size_t payload_index = frames.size() - 1;
-    const std::string request(static_cast<const char*>(frames[payload_index].data()),
-                              frames[payload_index].size());
+    // Envelope = the identity and every frame up to and including the empty delimiter (if
+    // there is one); exactly one payload frame must follow.
+    std::size_t envelope = 1;
+    for (std::size_t i = 1; i < frames.size(); ++i)
+      if (frames[i].size() == 0) {
+        envelope = i + 1;
+        break;
+      }
+    const std::size_t payload_frames = frames.size() - envelope;
     bool stop = false;
-    const std::string reply = handler(request, stop);
-    for (std::size_t i = 0; i < payload_index; ++i)
+    std::string reply;
+    if (payload_frames == 1) {
+      const auto& payload = frames[envelope];
+      reply = handler(std::string(static_cast<const char*>(payload.data()), payload.size()), stop);
+    } else if (frame_error_) {
+      reply = frame_error_(payload_frames);
+    } else {
+      continue;
+    }
+    for (std::size_t i = 0; i < envelope; ++i)
       impl_->socket.send(zmq::buffer(frames[i].data(), frames[i].size()), zmq::send_flags::sndmore);
     impl_->socket.send(zmq::buffer(reply), zmq::send_flags::none);
     if (stop) return true;

@@ -21,6 +21,9 @@ class Service {
 
  protected:
   virtual void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) = 0;
+  // "'solve_step' before 'configure'", naming the last Configure's failure if there was one.
+  std::string before_configure(const std::string& request) const;
+  std::string configure_failure_;
 };
 
 using fsi::SolidFactory;

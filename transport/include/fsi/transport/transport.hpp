@@ -70,8 +70,13 @@ class Server {
   // Returns false on idle timeout.
   bool serve(const Handler& handler, std::chrono::milliseconds idle_timeout,
              const std::function<bool()>& should_stop = {});
+  // The reply to a message that does not have exactly one frame after its envelope
+  // (identity and empty delimiter); without one, such a message is dropped.
+  using FrameErrorHandler = std::function<std::string(std::size_t payload_frames)>;
+  void set_frame_error_handler(FrameErrorHandler h) { frame_error_ = std::move(h); }
 
  private:
+  FrameErrorHandler frame_error_;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
