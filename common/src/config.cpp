@@ -1,6 +1,7 @@
 #include "fsi/common/config.hpp"
 
 #include <cmath>
+#include <map>
 #include <fstream>
 #include <sstream>
 
@@ -43,6 +44,24 @@ void apply_override(YAML::Node root, const std::string& assignment, const std::s
   chain.back()[parts.back()] = value;
 }
 
+// yaml-cpp keeps the last of two equal keys silently: refuse them, naming both lines.
+void check_duplicates(const YAML::Node& node, const std::string& path, const std::string& origin) {
+  if (node.IsMap()) {
+    std::map<std::string, YAML::Mark> seen;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.Scalar();
+      const std::string full = path.empty() ? key : path + "." + key;
+      const auto [it, fresh] = seen.emplace(key, kv.first.Mark());
+      if (!fresh)
+        throw ConfigError(mark_string(origin, kv.first.Mark()) + ": duplicate key '" + full + "' (first at " +
+                          mark_string(origin, it->second) + ")");
+      check_duplicates(kv.second, full, origin);
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) check_duplicates(node[i], path + "[" + std::to_string(i) + "]", origin);
+  }
+}
+
 void collect_unused(const YAML::Node& node, const std::string& path,
                     const std::set<std::string>& used, const std::string& origin,
                     std::vector<std::string>& unknown) {
@@ -77,6 +96,7 @@ Scene Scene::parse(const std::string& text, const std::string& origin,
   }
   if (!scene.state_->root || scene.state_->root.IsNull()) scene.state_->root = YAML::Node(YAML::NodeType::Map);
   if (!scene.state_->root.IsMap()) throw ConfigError(origin + ": a scene must be a YAML map of sections");
+  check_duplicates(scene.state_->root, "", origin);
   for (const auto& o : overrides) apply_override(scene.state_->root, o, origin);
   return scene;
 }
@@ -146,6 +166,13 @@ YAML::Node ConfigSection::lookup(const std::string& key) const {
   return YAML::Node(YAML::NodeType::Undefined);  // tests false with operator!
 }
 
+bool ConfigSection::node_is_scalar(const std::string& key) const {
+  if (node_.IsMap())
+    for (const auto& kv : node_)
+      if (kv.first.Scalar() == key) return kv.second.IsScalar();
+  return false;
+}
+
 bool ConfigSection::has(const std::string& key) const {
   if (!node_.IsMap()) return false;
   for (const auto& kv : node_)
@@ -212,9 +239,8 @@ std::array<double, 2> read_vector2(const ConfigSection& section, const std::stri
     section.get<double>(key, 0.0);  // marks the key as read
     return {0.0, 0.0};
   }
-  try {
-    return {section.get<double>(key), 0.0};
-  } catch (const ConfigError&) {
+  if (section.node_is_scalar(key)) return {section.get<double>(key), 0.0};
+  {
     const auto v = section.get<std::vector<double>>(key);
     if (v.size() != 2) section.fail(key, "must be a number or a list [x, y]");
     for (double x : v)

@@ -108,6 +108,13 @@ TimeSettings read_time(const Scene& scene) {
   if (s.checkpoint_keep < 1) t.fail("checkpoint_keep", "must be >= 1");
   s.steps = static_cast<int>(std::llround(s.end / s.dt));
   if (s.steps < 1) t.fail("end", "is shorter than one time step");
+  // A run ends at steps * dt: refuse an end that is not (to round-off) a whole number of steps.
+  if (std::abs(s.steps * s.dt - s.end) > 1e-9 * s.end) {
+    const long below = static_cast<long>(std::floor(s.end / s.dt)), above = below + 1;
+    t.fail("end", fmt::format("({}) must be a whole number of time steps dt = {}: end / dt = {:.6g}; use {:.10g} "
+                              "({} steps) or {:.10g} ({} steps)",
+                              s.end, s.dt, s.end / s.dt, below * s.dt, below, above * s.dt, above));
+  }
   return s;
 }
 

@@ -20,8 +20,13 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   c.nitsche_symmetry = s.get<double>("gamma_n2", -1.0);
   if (c.nitsche_symmetry != 1.0 && c.nitsche_symmetry != -1.0) s.fail("gamma_n2", "must be +1 or -1");
   c.relaxation = s.get<double>("relaxation");
-  if (!(c.relaxation > 0) || c.relaxation > 1.0 + 1e-12)
-    s.fail("relaxation", "(beta) must be in (0, 1]");
+  // The stability limit of the relaxed Dirichlet-Neumann iteration on the added-mass model
+  // (README): Algorithm 1: 2 m_eff / (m_eff + m_a) < 2; Algorithm 2: 2 (m_eff + gamma mu dt) /
+  // (m_eff + m_a), which grows with gamma (and can exceed 2).
+  if (!(c.relaxation > 0)) s.fail("relaxation", "(beta) must be > 0");
+  if (c.algorithm == Algorithm::ExplicitSolidVelocity && !(c.relaxation < 2.0))
+    s.fail("relaxation", "(beta) must be in (0, 2) with Algorithm 1 (its stability limit 2 m_eff / (m_eff + m_a) "
+                         "is below 2)");
   const auto predictor = s.get<std::string>("predictor", "previous");
   if (predictor == "previous") c.predictor = Predictor::Previous;
   else if (predictor == "linear") c.predictor = Predictor::Linear;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/standalone.hpp"
 
 namespace {
 
@@ -95,6 +96,37 @@ TEST(Config, HasDoesNotModifyTheTree) {
   EXPECT_FALSE(scene.has("solid.nope"));
   EXPECT_EQ(scene.section("solid").get<std::string>("model"), "sdof");
   EXPECT_DOUBLE_EQ(scene.section("solid").get<double>("mass"), 2.0);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Config, DuplicateKeyNamesBothLines) {
+  const std::string text = "scene: t\nsolid:\n  mass: 1\n  damping: 0\n  mass: 2\n";
+  const auto e = error_of([&] { fsi::Scene::parse(text, "d.yaml"); });
+  EXPECT_EQ(e, "d.yaml:5:3: duplicate key 'solid.mass' (first at d.yaml:3:3)");
+  EXPECT_NE(error_of([&] { fsi::Scene::parse("a: 1\na: 2\n", "top.yaml"); }).find("duplicate key 'a'"),
+            std::string::npos);
+}
+
+TEST(Config, NotFiniteVectorSaysFinite) {
+  auto scene = fsi::Scene::parse("fluid:\n  force: .nan\n", "f.yaml");
+  const auto e = error_of([&] { fsi::read_vector2(scene.section("fluid"), "force"); });
+  EXPECT_NE(e.find("'fluid.force' must be a finite number"), std::string::npos) << e;
+  auto listed = fsi::Scene::parse("fluid:\n  force: [1, .inf]\n", "f.yaml");
+  EXPECT_NE(error_of([&] { fsi::read_vector2(listed.section("fluid"), "force"); }).find("finite"), std::string::npos);
+}
+
+TEST(Config, EndMustBeAWholeNumberOfSteps) {
+  auto scene = fsi::Scene::parse("time: {dt: 0.02, end: 0.05}\n", "e.yaml");
+  const auto e = error_of([&] { fsi::read_time(scene); });
+  EXPECT_NE(e.find("'time.end' (0.05) must be a whole number of time steps dt = 0.02: end / dt = 2.5; use 0.04 (2 "
+                   "steps) or 0.06 (3 steps)"),
+            std::string::npos)
+      << e;
+  auto ok = fsi::Scene::parse("time: {dt: 0.0025, end: 4.5}\n", "e.yaml");
+  EXPECT_EQ(fsi::read_time(ok).steps, 1800);
 }
 
 }  // namespace

@@ -192,9 +192,20 @@ TEST(Outcome, UnknownCouplingKeyFailsWithItsName) {
 }
 
 TEST(Outcome, OutOfRangeRelaxationIsRejected) {
-  const auto run = run_scene({"coupling.relaxation=1.5"});
+  for (const char* beta : {"0", "-0.5"}) {
+    const auto run = run_scene({std::string("coupling.relaxation=") + beta});
+    EXPECT_EQ(run.outcome.status, "failed") << beta;
+    EXPECT_NE(run.outcome.reason.find("'coupling.relaxation' (beta) must be > 0"), std::string::npos) << run.outcome.reason;
+  }
+  const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=2.5"});
   EXPECT_EQ(run.outcome.status, "failed");
-  EXPECT_NE(run.outcome.reason.find("coupling.relaxation"), std::string::npos) << run.outcome.reason;
+  EXPECT_NE(run.outcome.reason.find("must be in (0, 2) with Algorithm 1"), std::string::npos) << run.outcome.reason;
+}
+
+TEST(Outcome, Algorithm2AcceptsRelaxationAboveOne) {
+  // Its limit 2 (m_eff + gamma mu dt) / (m_eff + m_a) exceeds 1 with enough damping.
+  const auto run = run_scene({"coupling.relaxation=1.2", "coupling.gamma_n1=100"});
+  EXPECT_EQ(run.outcome.status, "completed") << run.outcome.reason;
 }
 
 }  // namespace

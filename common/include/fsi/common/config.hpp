@@ -65,6 +65,8 @@ class ConfigSection {
  public:
   ConfigSection(std::shared_ptr<Scene::State> state, YAML::Node node, std::string path);
 
+  // The key is present and holds a scalar (not a list or a section).
+  bool node_is_scalar(const std::string& key) const;
   bool has(const std::string& key) const;
   template <class T>
   T get(const std::string& key) const;  // required
