@@ -39,6 +39,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Launcher limits: a server must write its port file within 10 s of starting and answer the
+// coupler's Hello within 10 s; at the end each process gets 3 s to exit after Stop, then
+// SIGTERM, then SIGKILL 0.5 s later.
+constexpr std::chrono::seconds kPortFileWait{10};
+constexpr int kHelloWaitSeconds = 10;
+
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int sig) { g_signal = sig; }
 
@@ -323,7 +329,7 @@ int run(const RunOptions& o) {
     for (const auto& [side, command] : {std::pair{std::string("solid"), o.solid_command}, {"fluid", o.fluid_command}}) {
       Server s{side, command, "", ports / (side + ".port"), out / (side + "_server.log")};
       const std::size_t i = side == "solid" ? 0 : 1;
-      children[i] = start_server(s, bin, "tcp://127.0.0.1:*", std::chrono::seconds(30));
+      children[i] = start_server(s, bin, "tcp://127.0.0.1:*", kPortFileWait);
       log->info("{} listening on {} (log: {})", children[i].name, s.endpoint, s.log.string());
       servers.push_back(s);
     }
@@ -332,7 +338,7 @@ int run(const RunOptions& o) {
     while (true) {
       std::vector<std::string> argv{(bin / "coupler").string(), o.scene_path, "--solid", servers[0].endpoint, "--fluid",
                                     servers[1].endpoint, "--out", o.out_dir, "--timeout", fmt::format("{}", o.timeout),
-                                    "--out-ready"};
+                                    "--connect-timeout", std::to_string(kHelloWaitSeconds), "--out-ready"};
       if (resume) argv.push_back("--resume");
       if (resume && attempts > 0) argv.push_back("--resume-or-restart");
       if (recover > 0) argv.push_back("--recoverable");
@@ -379,7 +385,7 @@ int run(const RunOptions& o) {
         kill(children[i].pid, SIGKILL);
         reap(children[i], true);
       }
-      children[i] = start_server(servers[i], bin, servers[i].endpoint, std::chrono::seconds(30));
+      children[i] = start_server(servers[i], bin, servers[i].endpoint, kPortFileWait);
       const nlohmann::json checkpoint = newest_checkpoint(out);
       const int from = checkpoint.is_object() ? checkpoint.value("step", 0) : 0;
       const double restart_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

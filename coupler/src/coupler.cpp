@@ -106,6 +106,18 @@ RunOutcome Coupler::run(RunReport& report) {
       map_ = InterfaceMap(solid_interface_, fluid_interface);
     }
     const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
+    if (time.output_every > 0)
+      for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
+                                          std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
+        if (!ok) log->warn("time.output_every: the {} '{}' cannot write output (supports_output is false)", side, who);
+    // Point interfaces: both sides' measures (int N^T N) should agree, or the Robin terms
+    // weigh the two sides differently (in effect a damping of the wrong size or sign).
+    if (solid_interface_.segments.empty() && fluid_interface.segments.empty() &&
+        solid_interface_.lumped_measure.size() == fluid_interface.lumped_measure.size()) {
+      const double a = solid_interface_.lumped_measure.sum(), b = fluid_interface.lumped_measure.sum();
+      if (std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b)))
+        log->warn("interface measures differ: solid {} vs fluid {} (interface_measure of the two sections)", a, b);
+    }
     data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
                          {"max_gap", map_.max_gap()}};
     data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
@@ -356,8 +368,8 @@ RunOutcome Coupler::run(RunReport& report) {
         if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
       probes.add(t_np1, row);
       if (time.output_every > 0 && n % time.output_every == 0) {
-        solid_.write_output(accepted);
-        fluid_.write_output(accepted);
+        if (solid_.supports_output()) solid_.write_output(accepted);
+        if (fluid_.supports_output()) fluid_.write_output(accepted);
       }
       accelerator.end_step();
       force_nm1 = force_n;

@@ -77,7 +77,7 @@ fsi::v1::Request configure_request(const ConfigSection& section, double dt, doub
 }
 
 std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* supports_damping,
-                  bool* supports_checkpoint) {
+                  bool* supports_checkpoint, bool* supports_output) {
   fsi::v1::Request r;
   r.mutable_hello()->set_client_name("fsi coupler");
   const auto reply = client.call(r);
@@ -88,8 +88,17 @@ std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* su
                       fmt::format("{} at {} is a {} server, expected a {} server", client.peer_name(),
                                   client.endpoint(), fsi::v1::ServerKind_Name(reply.hello().kind()),
                                   fsi::v1::ServerKind_Name(expected)));
+  if (reply.hello().protocol_version() != kProtocolVersion)
+    throw RemoteError(fsi::v1::Error::VERSION_MISMATCH,
+                      fmt::format("{} at {} speaks protocol version {} (HelloReply.protocol_version), this coupler {}",
+                                  client.peer_name(), client.endpoint(), reply.hello().protocol_version(),
+                                  kProtocolVersion));
+  if (reply.hello().server_name().empty())
+    throw RemoteError(fsi::v1::Error::MALFORMED,
+                      fmt::format("{} at {} sent a HelloReply without server_name", client.peer_name(), client.endpoint()));
   if (supports_damping) *supports_damping = reply.hello().supports_interface_damping();
   *supports_checkpoint = reply.hello().supports_checkpoint();
+  *supports_output = reply.hello().supports_output();
   return reply.hello().server_name();
 }
 
@@ -169,7 +178,7 @@ void stop_call(ProtocolClient& client, const std::string& reason) {
 
 // ---------------------------------------------------------------------------- solid
 RemoteSolid::RemoteSolid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
-  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_);
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_, &supports_output_);
 }
 
 std::string RemoteSolid::save_checkpoint(int step, double time) { return save_call(*client_, step, time); }
@@ -217,7 +226,7 @@ void RemoteSolid::stop(const std::string& reason) { stop_call(*client_, reason);
 
 // ---------------------------------------------------------------------------- fluid
 RemoteFluid::RemoteFluid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
-  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_FLUID, nullptr, &supports_checkpoint_);
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_FLUID, nullptr, &supports_checkpoint_, &supports_output_);
 }
 
 std::string RemoteFluid::save_checkpoint(int step, double time) { return save_call(*client_, step, time); }

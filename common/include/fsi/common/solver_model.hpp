@@ -84,6 +84,8 @@ class SolidModel {
   // Makes the last solve the new accepted state; returns named probes.
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
+  // False: write_output() is never called (a remote server without supports_output).
+  virtual bool supports_output() const { return true; }
   // Cumulative wall seconds by category (e.g. "assembly", "linear_solve"), reported in
   // the run summary. Optional.
   virtual std::map<std::string, double> timings() const { return {}; }
@@ -132,6 +134,8 @@ class FluidModel {
                                 const Eigen::VectorXd& interface_velocity) = 0;
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
+  // False: write_output() is never called (a remote server without supports_output).
+  virtual bool supports_output() const { return true; }
   // Cumulative wall seconds by category (e.g. "mesh_motion", "assembly", "linear_solve").
   virtual std::map<std::string, double> timings() const { return {}; }
   // Checkpoints: the state after the last accepted step; see the call order above.

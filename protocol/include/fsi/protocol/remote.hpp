@@ -26,6 +26,7 @@ class RemoteSolid : public SolidModel {
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
   bool supports_checkpoint() const override { return supports_checkpoint_; }
+  bool supports_output() const override { return supports_output_; }
   std::string save_checkpoint(int step, double time) override;
   void load_checkpoint(int step, double time, const std::string& bytes) override;
   void stop(const std::string& reason);
@@ -38,6 +39,7 @@ class RemoteSolid : public SolidModel {
   std::string server_name_ = "solid server";
   bool supports_damping_ = false;
   bool supports_checkpoint_ = false;
+  bool supports_output_ = false;
   InterfaceMeshData interface_;
 };
 
@@ -53,6 +55,7 @@ class RemoteFluid : public FluidModel {
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
   bool supports_checkpoint() const override { return supports_checkpoint_; }
+  bool supports_output() const override { return supports_output_; }
   std::string save_checkpoint(int step, double time) override;
   void load_checkpoint(int step, double time, const std::string& bytes) override;
   void stop(const std::string& reason);
@@ -64,6 +67,7 @@ class RemoteFluid : public FluidModel {
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "fluid server";
   bool supports_checkpoint_ = false;
+  bool supports_output_ = false;
   InterfaceMeshData interface_;
 };
 
