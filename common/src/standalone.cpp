@@ -118,15 +118,15 @@ TimeSettings read_time(const Scene& scene) {
   return s;
 }
 
-Progress::Progress(std::string logger_name, int total_steps)
-    : logger_name_(std::move(logger_name)), total_(total_steps), start_(now_seconds()) {}
+Progress::Progress(std::string logger_name, int total_steps, int first_step)
+    : logger_name_(std::move(logger_name)), total_(total_steps), first_(first_step), start_(now_seconds()) {}
 
 void Progress::update(int step, double time, const std::string& extra) {
   const double now = now_seconds();
   if (now - last_ < 2.0 && step != total_) return;
   last_ = now;
   const double elapsed = now - start_;
-  const double eta = step > 0 ? elapsed / step * (total_ - step) : 0.0;
+  const double eta = step > first_ ? elapsed / (step - first_) * (total_ - step) : 0.0;
   logger(logger_name_)->info("step {}/{} t={:.5g} {} elapsed {:.1f} s, ETA {:.1f} s", step, total_, time, extra,
                              elapsed, eta);
 }

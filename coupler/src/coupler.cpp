@@ -224,7 +224,7 @@ RunOutcome Coupler::run(RunReport& report) {
     CsvWriter iterations =
         restart ? CsvWriter::resume(out_dir_ / "iterations.csv", static_cast<std::size_t>(out.iterations), iteration_columns)
                 : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
-    Progress progress("coupler", time.steps);
+    Progress progress("coupler", time.steps, out.steps);
     const double segment_start = now();
     auto save_checkpoint = [&](int n, double t_np1) {
       Timer t(times_.checkpoint);

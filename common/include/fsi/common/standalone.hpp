@@ -46,12 +46,14 @@ TimeSettings read_time(const Scene& scene);
 // Progress line every few seconds: step, time, extra text, ETA.
 class Progress {
  public:
-  Progress(std::string logger_name, int total_steps);
+  // `first_step`: the step a resumed run starts after (the ETA counts only steps done here).
+  Progress(std::string logger_name, int total_steps, int first_step = 0);
   void update(int step, double time, const std::string& extra = "");
 
  private:
   std::string logger_name_;
   int total_;
+  int first_;
   double start_;
   double last_ = -1e9;
 };
