@@ -380,7 +380,8 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
     report.assembly_seconds += seconds_since(t_assembly);
 
     const Eigen::VectorXd U_new =
-        impl_->lu->solve(A, rhs, U_adv, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration));
+        impl_->lu->solve(A, rhs, U_adv, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
+                       steady ? 0.0 : alpha0 / dt);
 
     report.change = detail::relative_velocity_change(U_new, U_adv, n, [](int i, int c) { return 3 * i + c; });
     report.iterations = iteration;

@@ -14,7 +14,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-using LuSolver = Eigen::UmfPackLU<Eigen::SparseMatrix<double>>;
+
+// Eigen's UmfPackLU with UMFPACK's Info array (flop and nonzero counts) readable.
+class LuSolver : public Eigen::UmfPackLU<Eigen::SparseMatrix<double>> {
+ public:
+  double umfpack_info(int entry) const { return m_umfpackInfo(entry); }
+};
 
 // The factors of an earlier matrix used as a preconditioner (Eigen preconditioner concept).
 class FrozenLuPreconditioner {
@@ -31,6 +36,8 @@ class FrozenLuPreconditioner {
   const LuSolver* lu_ = nullptr;
 };
 
+const char* ordering_name(Ordering o) { return o == Ordering::Metis ? "metis" : o == Ordering::Amd ? "amd" : "auto"; }
+
 }  // namespace
 
 struct SparseLu::Impl {
@@ -39,22 +46,30 @@ struct SparseLu::Impl {
   bool analysed = false;
   bool factorised = false;
   bool stale = false;  // the factors precondition poorly: refactorise at the next solve
-  Ordering chosen = Ordering::Amd;
-  double cycle_seconds = 0;  // factorisation + solves since the last factorisation
+  double time_coefficient = 0;  // alpha0 / dt of the factorised matrix
+  Ordering chosen = Ordering::Auto;  // Auto until the first analysis decides (or a fixed one)
+  // Cost model of the current factors (flops, see sparse_lu.hpp): one application of the
+  // factors, one product with A, and the cost of the cycle so far (factorisation + solves).
+  double apply_flops = 0, product_flops = 0;
+  double cycle_flops = 0;
   int cycle_solves = 0;
-  std::pair<double, double> measured{0, 0};  // auto: factorisation seconds with AMD, METIS
+  std::pair<double, double> measured{0, 0};  // auto: UMFPACK factorisation flops with AMD, METIS
 };
 
-SparseLu::SparseLu(const FlowParameters& params) : impl_(std::make_unique<Impl>()) { impl_->params = params; }
+SparseLu::SparseLu(const FlowParameters& params) : impl_(std::make_unique<Impl>()) {
+  impl_->params = params;
+  if (params.ordering != Ordering::Auto) impl_->chosen = params.ordering;
+}
 SparseLu::~SparseLu() = default;
 SparseLu::SparseLu(SparseLu&&) noexcept = default;
 SparseLu& SparseLu::operator=(SparseLu&&) noexcept = default;
 
 Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, const Eigen::VectorXd& guess,
-                                StepReport& report, const std::string& where) {
+                                StepReport& report, const std::string& where, double time_coefficient) {
   auto& s = *impl_;
   const auto& p = s.params;
   Eigen::VectorXd x;
+  if (s.factorised && time_coefficient != s.time_coefficient) s.stale = true;
   if (p.reuse_factorisation && s.factorised && !s.stale) {
     const auto t_solve = Clock::now();
     Eigen::BiCGSTAB<Eigen::SparseMatrix<double>, FrozenLuPreconditioner> krylov;
@@ -63,17 +78,21 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
     krylov.setMaxIterations(p.krylov_max_iterations);
     krylov.compute(A);
     x = guess.size() == b.size() ? Eigen::VectorXd(krylov.solveWithGuess(b, guess)) : Eigen::VectorXd(krylov.solve(b));
-    const double seconds = seconds_since(t_solve);
-    report.solve_seconds += seconds;
+    report.solve_seconds += seconds_since(t_solve);
     if (krylov.info() == Eigen::Success && x.allFinite()) {
+      const auto iterations = static_cast<double>(krylov.iterations());
       report.krylov_iterations += static_cast<int>(krylov.iterations());
       if (krylov.iterations() > p.krylov_refactor_iterations) s.stale = true;
       // Cost-based refactorisation: the factorisation's cost is shared by every solve that
       // reuses it; once one more Krylov solve costs more than that running average (factorisation
-      // + its solves, per solve), a fresh factorisation is the cheaper next step.
-      s.cycle_seconds += seconds;
+      // + its solves, per solve), a fresh factorisation is the cheaper next step. Costs in
+      // flops (BiCGSTAB: one product with A, then per iteration two applications of the
+      // factors, two products and ~20 n flops of vector operations).
+      const double cost = s.product_flops +
+                          iterations * (2 * s.apply_flops + 2 * s.product_flops + 20.0 * static_cast<double>(A.rows()));
+      s.cycle_flops += cost;
       ++s.cycle_solves;
-      if (p.adaptive_refactorisation && seconds > s.cycle_seconds / s.cycle_solves) s.stale = true;
+      if (p.adaptive_refactorisation && cost > s.cycle_flops / s.cycle_solves) s.stale = true;
       return x;
     }
   }
@@ -87,30 +106,36 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
                                                                                       : UMFPACK_STRATEGY_AUTO;
       lu.analyzePattern(A);
     };
-    if (p.ordering == Ordering::Auto) {
-      // Measure both orderings on the first matrix (analysis + factorisation) and keep the
-      // one whose factorisation is faster: every later factorisation reuses its analysis.
+    if (s.chosen == Ordering::Auto) {
+      // Factorise the first matrix with both orderings and keep the one whose factorisation
+      // needs fewer flops (UMFPACK's count: deterministic, unlike timings); every later
+      // factorisation reuses its analysis.
       auto other = std::make_unique<LuSolver>();
-      analyse(*s.lu, Ordering::Amd);
       const auto t_amd = Clock::now();
+      analyse(*s.lu, Ordering::Amd);
       s.lu->factorize(A);
-      const double amd = seconds_since(t_amd);
-      analyse(*other, Ordering::Metis);
+      const double amd_seconds = seconds_since(t_amd);
       const auto t_metis = Clock::now();
+      analyse(*other, Ordering::Metis);
       other->factorize(A);
-      const double metis = seconds_since(t_metis);
-      s.chosen = metis < amd ? Ordering::Metis : Ordering::Amd;
+      const double metis_seconds = seconds_since(t_metis);
+      const bool amd_ok = s.lu->info() == Eigen::Success, metis_ok = other->info() == Eigen::Success;
+      const double amd = s.lu->umfpack_info(UMFPACK_FLOPS), metis = other->umfpack_info(UMFPACK_FLOPS);
+      s.chosen = metis_ok && (!amd_ok || metis < amd) ? Ordering::Metis : Ordering::Amd;
       s.measured = {amd, metis};
       if (s.chosen == Ordering::Metis) std::swap(s.lu, other);
-      fsi::logger("fluid")->info("linear solver: ordering auto chose {} (first factorisation of {} unknowns: AMD {:.3f} s, "
-                                 "METIS {:.3f} s)",
-                                 s.chosen == Ordering::Metis ? "METIS" : "AMD", A.rows(), amd, metis);
+      const LuSolver& amd_lu = s.chosen == Ordering::Metis ? *other : *s.lu;
+      const LuSolver& metis_lu = s.chosen == Ordering::Metis ? *s.lu : *other;
+      fsi::logger("fluid")->info("linear solver: ordering auto chose {} (first factorisation of {} unknowns: AMD {:.3g} "
+                                 "flops, nnz(L+U) {:.3g}, {:.3f} s; METIS {:.3g} flops, nnz(L+U) {:.3g}, {:.3f} s)",
+                                 s.chosen == Ordering::Metis ? "METIS" : "AMD", A.rows(), amd,
+                                 amd_lu.umfpack_info(UMFPACK_LNZ) + amd_lu.umfpack_info(UMFPACK_UNZ), amd_seconds, metis,
+                                 metis_lu.umfpack_info(UMFPACK_LNZ) + metis_lu.umfpack_info(UMFPACK_UNZ), metis_seconds);
     } else {
-      analyse(*s.lu, p.ordering);
-      s.chosen = p.ordering;
+      analyse(*s.lu, s.chosen);
+      s.lu->factorize(A);
     }
     s.analysed = true;
-    if (p.ordering != Ordering::Auto) s.lu->factorize(A);
   } else {
     s.lu->factorize(A);
   }
@@ -118,22 +143,57 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
     throw SolverError(fmt::format("{}: UMFPACK factorisation failed (singular matrix?: check that the pressure is fixed "
                                   "by an outlet or a pressure reference)",
                                   where));
+  const double factor_flops = s.lu->umfpack_info(UMFPACK_FLOPS);
+  const double lu_nonzeros = s.lu->umfpack_info(UMFPACK_LNZ) + s.lu->umfpack_info(UMFPACK_UNZ);
   s.factorised = true;
   s.stale = false;
+  s.time_coefficient = time_coefficient;
   ++report.factorisations;
   report.factor_seconds += seconds_since(t_factor);
   const auto t_solve = Clock::now();
   x = s.lu->solve(b);
   report.solve_seconds += seconds_since(t_solve);
-  s.cycle_seconds = seconds_since(t_factor);
+  const double solve_flops = s.lu->umfpack_info(UMFPACK_SOLVE_FLOPS);
+  s.apply_flops = solve_flops > 0 ? solve_flops : 2 * lu_nonzeros;
+  s.product_flops = 2.0 * static_cast<double>(A.nonZeros());
+  s.cycle_flops = factor_flops / kFactorFlopSpeedup + s.apply_flops;
   s.cycle_solves = 1;
   if (!x.allFinite()) throw SolverError(fmt::format("{}: the solution is not finite", where));
   return x;
 }
 
-}  // namespace fsi::fluid
+void SparseLu::discard_factors() {
+  auto& s = *impl_;
+  s.lu = std::make_unique<LuSolver>();
+  s.analysed = s.factorised = s.stale = false;
+  s.apply_flops = s.product_flops = s.cycle_flops = 0;
+  s.cycle_solves = 0;
+}
 
-namespace fsi::fluid {
+void SparseLu::save_state(StateArchive& state, const std::string& prefix) const {
+  const auto& s = *impl_;
+  state.put(prefix + "ordering", std::string(ordering_name(s.chosen)));
+  state.put(prefix + "auto_trial_flops", std::vector<double>{s.measured.first, s.measured.second});
+}
+
+void SparseLu::load_state(const StateArchive& state, const std::string& prefix) {
+  auto& s = *impl_;
+  const std::string name = state.text(prefix + "ordering");
+  Ordering saved;
+  if (name == "amd") saved = Ordering::Amd;
+  else if (name == "metis") saved = Ordering::Metis;
+  else if (name == "auto") saved = Ordering::Auto;
+  else throw StateError(fmt::format("entry '{}ordering' is '{}', expected amd, metis or auto", prefix, name));
+  if (s.params.ordering != Ordering::Auto && saved != Ordering::Auto && saved != s.params.ordering)
+    throw StateError(fmt::format("entry '{}ordering' is '{}' but this configuration fixes linear_solver.ordering: {}",
+                                 prefix, name, ordering_name(s.params.ordering)));
+  const Eigen::VectorXd trial = state.vector(prefix + "auto_trial_flops", 2);
+  discard_factors();
+  if (saved != Ordering::Auto) s.chosen = saved;
+  s.measured = {trial(0), trial(1)};
+}
+
 Ordering SparseLu::ordering() const { return impl_->chosen; }
 std::pair<double, double> SparseLu::measured_orderings() const { return impl_->measured; }
+
 }  // namespace fsi::fluid

@@ -365,7 +365,8 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
 
     im.last_rhs = rhs;
     Eigen::VectorXd U_new =
-        im.lu->solve(A, rhs, U_lin, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration));
+        im.lu->solve(A, rhs, U_lin, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
+                       steady ? 0.0 : alpha0 / dt);
 
     double change = detail::relative_velocity_change(U_new, U_lin, n, [](int i, int c) { return 2 * i + c; });
     // Damped Newton: an update that grows the change is halved (iterations 3 on, so the first

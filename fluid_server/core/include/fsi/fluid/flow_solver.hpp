@@ -28,7 +28,8 @@ struct StabilisationParameters {
   bool viscous_residual = false;  // P1/P1: include the reconstructed div(mu grad u*) in r_M
 };
 
-// Fill-reducing ordering of the sparse LU (UMFPACK); Auto measures both on the first matrix.
+// Fill-reducing ordering of the sparse LU (UMFPACK); Auto tries both on the first matrix and
+// keeps the one whose factorisation needs fewer flops.
 enum class Ordering { Amd, Metis, Auto };
 // UMFPACK's strategy: Symmetric (AMD/METIS on A + A^T, diagonal pivots preferred) suits both
 // elements' saddle-point matrices (measured: 20 % faster factorisations, 30 % faster solves
@@ -63,7 +64,8 @@ struct FlowParameters {
   int krylov_max_iterations = 25;
   int krylov_refactor_iterations = 8;  // a solve needing more marks the factors stale: refactorise next time
   // Refactorise as soon as a Krylov solve costs more than the average cost per solve of the
-  // current factors (their factorisation included): minimises the time per step.
+  // current factors (their factorisation included): minimises the cost per step. Costs are
+  // counted in flops, not measured, so the decisions are reproducible (sparse_lu.hpp).
   bool adaptive_refactorisation = true;
 };
 
