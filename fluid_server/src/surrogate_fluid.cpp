@@ -48,4 +48,18 @@ std::map<std::string, double> SurrogateFluid::accept_step(const StepInfo&) {
   return {{"force_x", last_force_on_solid_[0]}, {"force_y", last_force_on_solid_[1]}};
 }
 
+void SurrogateFluid::save_state(StateArchive& state) {
+  state.put("surrogate.v_n", Eigen::VectorXd(v_n_));
+  state.put("surrogate.v", Eigen::VectorXd(v_));
+  state.put("surrogate.force_on_solid", Eigen::VectorXd(last_force_on_solid_));
+}
+
+void SurrogateFluid::load_state(const StateArchive& state) {
+  const Eigen::VectorXd v_n = state.vector("surrogate.v_n", 2), v = state.vector("surrogate.v", 2),
+                        f = state.vector("surrogate.force_on_solid", 2);
+  v_n_ = v_n;
+  v_ = v;
+  last_force_on_solid_ = f;
+}
+
 }  // namespace fsi::models

@@ -23,6 +23,11 @@ class SurrogateFluid : public FluidModel {
   FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
+  // Checkpoints: "surrogate.v_n" (accepted interface velocity), "surrogate.v" (of the last
+  // solve), "surrogate.force_on_solid" (of the last solve), 2 values each.
+  bool supports_checkpoint() const override { return true; }
+  void save_state(StateArchive& state) override;
+  void load_state(const StateArchive& state) override;
 
  private:
   FluidLoads loads(const Eigen::Vector2d& v, const Eigen::Vector2d& acceleration);
