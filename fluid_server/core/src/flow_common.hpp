@@ -4,6 +4,7 @@
 // the strong constraints as identity rows, the relative velocity change. Private to fsi_fluid.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/state.hpp"
 #include "fsi/fluid/flow_solver.hpp"
 
 namespace fsi::fluid::detail {
@@ -135,6 +137,76 @@ double relative_velocity_change(const Eigen::VectorXd& u_new, const Eigen::Vecto
       norm += std::pow(u_new(k), 2);
     }
   return std::sqrt(diff / std::max(norm, 1e-300));
+}
+
+// The time-stepping state both solvers carry from one step to the next (checkpoints): the
+// solution of the last solve and the BDF history, the mesh positions of the last solve and
+// the two accepted levels (the BDF mesh velocity), the step sizes and counts (BDF1 vs BDF2,
+// relinearisation), the interface velocity of the last solve, the reactions (forces).
+struct FlowState {
+  Eigen::VectorXd &U, &U_n, &U_nm1, &reaction;
+  Eigen::MatrixX2d &X, &X_n, &X_nm1;
+  double &dt_n, &dt_trial;
+  int &accepted, &trial_solves;
+  Eigen::VectorXd& interface_velocity;
+};
+
+inline Eigen::VectorXd flatten(const Eigen::MatrixX2d& m) { return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()); }
+
+inline Eigen::MatrixX2d unflatten(const Eigen::VectorXd& v) {
+  return Eigen::Map<const Eigen::MatrixX2d>(v.data(), v.size() / 2, 2);
+}
+
+// Entries under `prefix`: element (text), u, u_n, u_nm1, reaction (every unknown), x, x_n,
+// x_nm1 (every node, column-major: all x then all y), dt_n, dt_trial, accepted_steps,
+// trial_solves, interface_velocity (2 per interface node).
+inline void save_flow_state(StateArchive& state, const std::string& prefix, const std::string& element,
+                            const FlowState& f) {
+  state.put(prefix + "element", element);
+  state.put(prefix + "u", f.U);
+  state.put(prefix + "u_n", f.U_n);
+  state.put(prefix + "u_nm1", f.U_nm1);
+  state.put(prefix + "reaction", f.reaction);
+  state.put(prefix + "x", flatten(f.X));
+  state.put(prefix + "x_n", flatten(f.X_n));
+  state.put(prefix + "x_nm1", flatten(f.X_nm1));
+  state.put(prefix + "dt_n", f.dt_n);
+  state.put(prefix + "dt_trial", f.dt_trial);
+  state.put(prefix + "accepted_steps", static_cast<std::int64_t>(f.accepted));
+  state.put(prefix + "trial_solves", static_cast<std::int64_t>(f.trial_solves));
+  state.put(prefix + "interface_velocity", f.interface_velocity);
+}
+
+// Reads every entry before changing anything: a state that does not fit (another element,
+// mesh or interface) throws fsi::StateError naming the entry and leaves the solver as it was.
+inline void load_flow_state(const StateArchive& state, const std::string& prefix, const std::string& element,
+                            const FlowState& f) {
+  const std::string saved = state.text(prefix + "element");
+  if (saved != element)
+    throw StateError(fmt::format("entry '{}element' is '{}', this configuration uses fluid.element {}", prefix, saved,
+                                 element));
+  const Eigen::Index ndof = f.U.size(), npos = f.X.size();
+  Eigen::VectorXd U = state.vector(prefix + "u", ndof), U_n = state.vector(prefix + "u_n", ndof),
+                  U_nm1 = state.vector(prefix + "u_nm1", ndof), reaction = state.vector(prefix + "reaction", ndof);
+  const Eigen::VectorXd X = state.vector(prefix + "x", npos), X_n = state.vector(prefix + "x_n", npos),
+                        X_nm1 = state.vector(prefix + "x_nm1", npos);
+  Eigen::VectorXd iface = state.vector(prefix + "interface_velocity", f.interface_velocity.size());
+  const double dt_n = state.real(prefix + "dt_n"), dt_trial = state.real(prefix + "dt_trial");
+  const auto accepted = state.integer(prefix + "accepted_steps"), trial = state.integer(prefix + "trial_solves");
+  if (accepted < 0 || trial < 0)
+    throw StateError(fmt::format("entries '{}accepted_steps' / '{}trial_solves' are negative", prefix, prefix));
+  f.U = std::move(U);
+  f.U_n = std::move(U_n);
+  f.U_nm1 = std::move(U_nm1);
+  f.reaction = std::move(reaction);
+  f.X = unflatten(X);
+  f.X_n = unflatten(X_n);
+  f.X_nm1 = unflatten(X_nm1);
+  f.interface_velocity = std::move(iface);
+  f.dt_n = dt_n;
+  f.dt_trial = dt_trial;
+  f.accepted = static_cast<int>(accepted);
+  f.trial_solves = static_cast<int>(trial);
 }
 
 }  // namespace fsi::fluid::detail

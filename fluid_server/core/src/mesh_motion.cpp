@@ -161,4 +161,22 @@ void MeshMotion::accept(const Eigen::VectorXd& moving_displacement) {
 
 double MeshMotion::seconds() const { return impl_->seconds; }
 
+void MeshMotion::save_state(StateArchive& state, const std::string& prefix) const {
+  const auto& m = *impl_;
+  state.put(prefix + "base_displacement",
+            Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(m.base_displacement.data(), m.base_displacement.size())));
+  state.put(prefix + "base_moving", m.base_moving);
+}
+
+void MeshMotion::load_state(const StateArchive& state, const std::string& prefix) {
+  auto& m = *impl_;
+  const Eigen::VectorXd base = state.vector(prefix + "base_displacement", 2 * static_cast<Eigen::Index>(m.nodes));
+  Eigen::VectorXd moving = state.vector(prefix + "base_moving", m.base_moving.size());
+  const double start = now();
+  m.base_displacement = Eigen::Map<const Eigen::MatrixX2d>(base.data(), m.nodes, 2);
+  m.base_moving = std::move(moving);
+  if (m.options.incremental) m.build(m.mesh->nodes + m.base_displacement);
+  m.seconds += now() - start;
+}
+
 }  // namespace fsi::fluid

@@ -8,6 +8,7 @@
 #include <functional>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 
 #include <unistd.h>
 
@@ -98,6 +99,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
   const auto element = section.get<std::string>("element", "p1p1");
   if (element != "p1p1" && element != "p2p1") section.fail("element", "must be p1p1 or p2p1, got '" + element + "'");
   const bool taylor_hood = element == "p2p1";
+  element_ = element;
 
   // --- mesh ---
   const auto mesh_section = section.child("mesh");
@@ -481,6 +483,35 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
                                setup_.end_time, 100 * done, elapsed, eta, extra);
   }
   return probes;
+}
+
+void NavierStokesFluid::save_state(StateArchive& state) {
+  if (!solver_) throw std::logic_error("NavierStokesFluid::save_state before configure()");
+  solver_->save_state(state, "flow.");
+  if (motion_) motion_->save_state(state, "mesh.");
+  state.put("fluid.last_interface_displacement", last_interface_displacement_);
+  state.put("fluid.factorisations", static_cast<std::int64_t>(factorisations_));
+  state.put("fluid.solves", static_cast<std::int64_t>(solves_));
+}
+
+void NavierStokesFluid::load_state(const StateArchive& state) {
+  if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
+  if (const auto saved = state.text("flow.element"); saved != element_)
+    throw StateError(fmt::format("entry 'flow.element' is '{}', this configuration uses fluid.element {}", saved, element_));
+  if (!motion_ && state.has("mesh.base_displacement"))
+    throw StateError("entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
+  const Eigen::VectorXd last = state.vector("fluid.last_interface_displacement");
+  const auto interface_size = 2 * static_cast<Eigen::Index>(solver_->interface_nodes().size());
+  if (last.size() != 0 && last.size() != interface_size)
+    throw StateError(fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration needs {} "
+                                 "(a different mesh or scene?)",
+                                 last.size(), interface_size));
+  const auto factorisations = state.integer("fluid.factorisations"), solves = state.integer("fluid.solves");
+  solver_->load_state(state, "flow.");
+  if (motion_) motion_->load_state(state, "mesh.");
+  last_interface_displacement_ = last;
+  factorisations_ = static_cast<int>(factorisations);
+  solves_ = static_cast<int>(solves);
 }
 
 std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {

@@ -403,6 +403,21 @@ void NavierStokesSolver::accept() {
   trial_solves_ = 0;
 }
 
+void NavierStokesSolver::save_state(StateArchive& state, const std::string& prefix) {
+  detail::save_flow_state(state, prefix, "p1p1",
+                          {U_, U_n_, U_nm1_, reaction_, X_, X_n_, X_nm1_, dt_n_, dt_trial_, accepted_, trial_solves_,
+                           interface_velocity_});
+  impl_->lu->save_state(state, prefix + "lu.");
+  impl_->lu->discard_factors();  // the next solve refactorises, as in a solver restored from this state
+}
+
+void NavierStokesSolver::load_state(const StateArchive& state, const std::string& prefix) {
+  detail::load_flow_state(state, prefix, "p1p1",
+                          {U_, U_n_, U_nm1_, reaction_, X_, X_n_, X_nm1_, dt_n_, dt_trial_, accepted_, trial_solves_,
+                           interface_velocity_});
+  impl_->lu->load_state(state, prefix + "lu.");
+}
+
 Eigen::MatrixX2d NavierStokesSolver::velocity() const {
   Eigen::MatrixX2d v(mesh_.node_count(), 2);
   for (int i = 0; i < mesh_.node_count(); ++i) v.row(i) << U_(3 * i), U_(3 * i + 1);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/state.hpp"
 #include "fsi/fluid/mesh.hpp"
 
 namespace fsi::fluid {
@@ -97,6 +98,16 @@ class FlowSolver {
   virtual StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions,
                            const Eigen::VectorXd& interface_velocity) = 0;
   virtual void accept() = 0;
+
+  // --- checkpoints (after accept()) ---
+  // Writes everything the next solve depends on under `prefix` (e.g. "flow.": flow.u,
+  // flow.u_n, flow.x_n, flow.lu.ordering, ...) and drops the LU factors, so that the next
+  // solve refactorises, exactly as a solver restored from this state does.
+  virtual void save_state(StateArchive& state, const std::string& prefix) = 0;
+  // On a solver set up like the saved one (same mesh, conditions and parameters), before any
+  // solve: continues bit for bit as the saved one. fsi::StateError (naming the entry) when
+  // the state does not fit (another element or mesh).
+  virtual void load_state(const StateArchive& state, const std::string& prefix) = 0;
 
   // --- results of the last solve ---
   virtual const FluidMesh& mesh() const = 0;

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/state.hpp"
 #include "fsi/fluid/mesh.hpp"
 
 namespace fsi::fluid {
@@ -46,6 +47,13 @@ class MeshMotion {
   // on the mesh it produced). Throws fsi::SolverError if that mesh has an inverted element.
   void accept(const Eigen::VectorXd& moving_displacement);
   double seconds() const;  // wall time spent in extend() and accept()
+
+  // Checkpoints: the mesh of the last accepted step (prefix + "base_displacement", every node,
+  // column-major, and "base_moving", the moving nodes' displacement there). The extension is
+  // a direct solve (no initial guess); incremental: load_state() rebuilds the operator on that
+  // mesh, as accept() did. fsi::StateError (naming the entry) for another mesh.
+  void save_state(StateArchive& state, const std::string& prefix) const;
+  void load_state(const StateArchive& state, const std::string& prefix);
 
  private:
   struct Impl;

@@ -41,6 +41,16 @@ class NavierStokesFluid : public FluidModel {
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
 
+  // Checkpoints (after accept_step): the flow solver's state ("flow.*": velocity, pressure and
+  // BDF history, positions, step sizes and counts, interface velocity, "flow.lu.ordering"),
+  // the mesh motion's ("mesh.*", when the scene has an interface), and this model's
+  // ("fluid.last_interface_displacement", "fluid.factorisations", "fluid.solves"). Saving
+  // drops the LU factors: the next solve refactorises, in the saved model as in a restored one.
+  // Timings are not restored (they are this process's).
+  bool supports_checkpoint() const override { return true; }
+  void save_state(StateArchive& state) override;
+  void load_state(const StateArchive& state) override;
+
   // For tests and benchmarks.
   const FlowSolver& solver() const { return *solver_; }
   FlowSolver& solver() { return *solver_; }
@@ -60,6 +70,7 @@ class NavierStokesFluid : public FluidModel {
     double coefficient_scale = 0;  // 2 / (rho U^2 L), 0 = no coefficients
   };
   FluidSetup setup_;
+  std::string element_;  // fluid.element: p1p1 or p2p1
   std::unique_ptr<FlowSolver> solver_;
   FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
   bool motion_on_vertices_ = false;

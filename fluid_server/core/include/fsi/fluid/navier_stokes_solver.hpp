@@ -48,6 +48,10 @@ class NavierStokesSolver : public FlowSolver {
   // (interleaved, 2 * interface_nodes().size(); empty = zero). Repeatable before accept().
   StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity) override;
   void accept() override;
+  // Checkpoints (FlowSolver): entries under `prefix` (detail::save_flow_state in
+  // flow_common.hpp, element "p1p1") and the linear solver's under prefix + "lu.".
+  void save_state(StateArchive& state, const std::string& prefix) override;
+  void load_state(const StateArchive& state, const std::string& prefix) override;
 
   // --- results of the last solve ---
   const FluidMesh& mesh() const override { return mesh_; }

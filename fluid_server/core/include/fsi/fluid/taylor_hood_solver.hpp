@@ -38,6 +38,10 @@ class TaylorHoodSolver : public FlowSolver {
   StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions,
                    const Eigen::VectorXd& interface_velocity) override;
   void accept() override;
+  // Checkpoints (FlowSolver): entries under `prefix` (detail::save_flow_state in
+  // flow_common.hpp, element "p2p1") and the linear solver's under prefix + "lu.".
+  void save_state(StateArchive& state, const std::string& prefix) override;
+  void load_state(const StateArchive& state, const std::string& prefix) override;
 
   const FluidMesh& mesh() const override { return mesh_; }
   const FlowParameters& parameters() const override { return params_; }
