@@ -16,6 +16,7 @@ import glob
 import math
 import os
 import signal
+import struct
 import sys
 
 import yaml
@@ -103,6 +104,10 @@ class SdofSolid:
         return {"d_x": self.d[0], "d_y": self.d[1], "v_x": self.v[0], "v_y": self.v[1]}
 
 
+STATE_TAG = b"PYSDOF01"
+STATE_FORMAT = "<8s4d"
+
+
 def handle(pb, solid, request):
     reply = pb.Reply(protocol_version=VERSION, sequence=request.sequence)
     if request.protocol_version != VERSION:
@@ -116,6 +121,7 @@ def handle(pb, solid, request):
             reply.hello.server_name = "python sdof_solid.py"
             reply.hello.protocol_version = VERSION
             reply.hello.supports_interface_damping = True
+            reply.hello.supports_checkpoint = True
         elif body == "configure":
             c = request.configure
             scene = yaml.safe_load(c.scene_text) or {}
@@ -148,6 +154,18 @@ def handle(pb, solid, request):
         elif body == "accept_step":
             for name, value in solid.accept().items():
                 reply.accept.probes[name] = value
+        elif body == "save_checkpoint":
+            # Our own format: a tag, then d_n and v_n (what the next step depends on).
+            reply.checkpoint.state = struct.pack(STATE_FORMAT, STATE_TAG, *solid.d_n, *solid.v_n)
+        elif body == "load_checkpoint":
+            state = request.load_checkpoint.state
+            if len(state) != struct.calcsize(STATE_FORMAT) or state[:8] != STATE_TAG:
+                raise InvalidArgument(f"checkpoint of step {request.load_checkpoint.step}: {len(state)} bytes, not a "
+                                      f"state of this solid ({struct.calcsize(STATE_FORMAT)} bytes starting {STATE_TAG!r})")
+            values = struct.unpack(STATE_FORMAT, state)[1:]
+            solid.d_n, solid.v_n = list(values[0:2]), list(values[2:4])
+            solid.d, solid.v = list(solid.d_n), list(solid.v_n)
+            reply.loaded.SetInParent()
         elif body == "write_output":
             reply.output.SetInParent()
         elif body == "stop":

@@ -63,12 +63,30 @@ std::vector<std::pair<int, fs::path>> complete_folders(const fs::path& dir) {
   return out;
 }
 
-void flatten(const nlohmann::json& j, const std::string& prefix, std::map<std::string, std::string>& out) {
+void flatten(const nlohmann::json& j, const std::string& prefix, std::map<std::string, nlohmann::json>& out) {
   if (j.is_object()) {
     for (auto it = j.begin(); it != j.end(); ++it) flatten(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
   } else {
-    out[prefix] = j.dump();
+    out[prefix] = j;
   }
+}
+
+// Equal as the solvers see them: 1 and 1.0 are the same number.
+bool same_value(const nlohmann::json& a, const nlohmann::json& b) {
+  if (a.is_number() && b.is_number()) return a.get<double>() == b.get<double>();
+  if (a.is_array() && b.is_array()) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (!same_value(a[i], b[i])) return false;
+    return true;
+  }
+  if (a.is_object() && b.is_object()) {
+    if (a.size() != b.size()) return false;
+    for (auto it = a.begin(); it != a.end(); ++it)
+      if (!b.contains(it.key()) || !same_value(it.value(), b.at(it.key()))) return false;
+    return true;
+  }
+  return a == b;
 }
 
 }  // namespace
@@ -139,19 +157,19 @@ std::optional<CheckpointStore::Loaded> CheckpointStore::newest(std::vector<std::
 }
 
 std::vector<std::string> parameter_differences(const nlohmann::json& saved, const nlohmann::json& now) {
-  std::map<std::string, std::string> a, b;
+  std::map<std::string, nlohmann::json> a, b;
   flatten(saved, "", a);
   flatten(now, "", b);
   std::vector<std::string> out;
   for (const auto& [key, value] : a) {
     const auto it = b.find(key);
     if (it == b.end())
-      out.push_back(fmt::format("{}: {} (checkpoint) vs absent (now)", key, value));
-    else if (it->second != value)
-      out.push_back(fmt::format("{}: {} (checkpoint) vs {} (now)", key, value, it->second));
+      out.push_back(fmt::format("{}: {} (checkpoint) vs absent (now)", key, value.dump()));
+    else if (!same_value(it->second, value))
+      out.push_back(fmt::format("{}: {} (checkpoint) vs {} (now)", key, value.dump(), it->second.dump()));
   }
   for (const auto& [key, value] : b)
-    if (!a.count(key)) out.push_back(fmt::format("{}: absent (checkpoint) vs {} (now)", key, value));
+    if (!a.count(key)) out.push_back(fmt::format("{}: absent (checkpoint) vs {} (now)", key, value.dump()));
   return out;
 }
 

@@ -53,4 +53,14 @@ std::map<std::string, double> SdofSolid::accept_step(const StepInfo&) {
   return {{"d_x", d_[0]}, {"d_y", d_[1]}, {"v_x", v_[0]}, {"v_y", v_[1]}};
 }
 
+void SdofSolid::save_state(StateArchive& state) {
+  state.put("sdof.d_n", Eigen::VectorXd(d_n_));
+  state.put("sdof.v_n", Eigen::VectorXd(v_n_));
+}
+
+void SdofSolid::load_state(const StateArchive& state) {
+  d_n_ = d_ = state.vector("sdof.d_n", 2);
+  v_n_ = v_ = state.vector("sdof.v_n", 2);
+}
+
 }  // namespace fsi::models

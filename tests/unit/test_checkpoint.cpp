@@ -134,6 +134,8 @@ TEST(CheckpointStore, ParameterDifferencesNameTheKeys) {
   EXPECT_EQ(d[0], "time.end: 2 (checkpoint) vs 3 (now)");
   EXPECT_EQ(d[1], "solid.damping: absent (checkpoint) vs 0.5 (now)");
   EXPECT_TRUE(fsi::coupling::parameter_differences(a, a).empty());
+  const nlohmann::json c = {{"time", {{"dt", 0.01}, {"end", 2.0}}}, {"solid", {{"mass", 1.0}}}};
+  EXPECT_TRUE(fsi::coupling::parameter_differences(a, c).empty());  // 2 and 2.0 are the same number
 }
 
 TEST(CsvWriter, ResumeKeepsTheFirstRowsAndAppends) {

@@ -20,6 +20,9 @@ class SdofSolid : public SolidModel {
   InterfaceMeshData interface() const override;
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
+  bool supports_checkpoint() const override { return true; }
+  void save_state(StateArchive& state) override;
+  void load_state(const StateArchive& state) override;
 
  private:
   double mass_ = 1, damping_ = 0, stiffness_ = 0, measure_ = 1, interface_damping_ = 0;

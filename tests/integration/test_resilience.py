@@ -1,0 +1,353 @@
+#!/usr/bin/env python3
+"""Resilient runs over loopback: checkpoints, --resume, automatic recovery (--recover) after
+kill -9 / kill -STOP of a server, the coupler's own death, and every exit path's code and
+final summary.json. Real processes on 127.0.0.1 (harness.py); every wait is bounded."""
+import os
+import random
+import signal
+import subprocess
+import time
+
+import psutil
+
+from harness import main, summary
+
+FSI3_COARSE = ["fluid.mesh.size=0.04", "fluid.mesh.parameters={hc: 0.006, hw: 0.016}"]
+
+
+def rows(path):
+    try:
+        with open(path) as f:
+            return max(0, sum(1 for _ in f) - 1)
+    except OSError:
+        return 0
+
+
+def read(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+def wait_rows(path, n, proc, timeout):
+    """Waits until `path` has at least n data rows (fails if `proc` ends first)."""
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        if rows(path) >= n:
+            return
+        if proc.poll() is not None:
+            raise AssertionError(f"the run ended (code {proc.returncode}) before {path} had {n} rows")
+        time.sleep(0.01)
+    raise AssertionError(f"{path} did not reach {n} rows within {timeout} s")
+
+
+def processes_of(out):
+    """Live processes started for the run in `out` (their command line names the folder)."""
+    found = []
+    for p in psutil.process_iter(["pid", "cmdline", "status"]):
+        try:
+            cmd = " ".join(p.info["cmdline"] or [])
+        except psutil.Error:
+            continue
+        if out in cmd and p.info["status"] != psutil.STATUS_ZOMBIE:
+            found.append(p)
+    return found
+
+
+def process_named(out, name, timeout=20):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        for p in processes_of(out):
+            try:
+                if os.path.basename(p.cmdline()[0]) == name:
+                    return p
+            except (psutil.Error, IndexError):
+                pass
+        time.sleep(0.02)
+    raise AssertionError(f"no {name} process for {out} within {timeout} s")
+
+
+def server_of(launcher, side):
+    """The launcher's child serving `side` (solid/fluid)."""
+    for c in psutil.Process(launcher.pid).children():
+        try:
+            if os.path.basename(c.cmdline()[0]) == f"{side}_server":
+                return c
+        except (psutil.Error, IndexError):
+            pass
+    raise AssertionError(f"the launcher has no {side}_server child")
+
+
+def assert_no_leftovers(out, timeout=3):
+    deadline = time.time() + timeout
+    while time.time() < deadline and processes_of(out):
+        time.sleep(0.05)
+    left = [(p.pid, " ".join(p.cmdline())) for p in processes_of(out)]
+    assert not left, f"processes left running: {left}"
+
+
+def assert_final(out, status, code=None, got=None):
+    s = summary(out)
+    assert s["status"] == status, (status, s["status"], s["reason"])
+    n = rows(os.path.join(out, "probes.csv"))
+    assert s["steps"] == n, f"summary says {s['steps']} steps, probes.csv has {n} rows"
+    if code is not None:
+        assert got == code, f"exit code {got}, expected {code} ({s['status']}: {s['reason']})"
+    return s
+
+
+def launch(env, scene, out, sets, extra=()):
+    args = [env.exe("fsi"), "run", env.config(scene), "--out", out, *extra]
+    for s in sets:
+        args += ["--set", s]
+    return env.spawn(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def finish(p, timeout):
+    try:
+        out, _ = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        env_kill(p)
+        raise AssertionError(f"the run did not end within {timeout} s")
+    return p.returncode, out
+
+
+def env_kill(p):
+    try:
+        os.killpg(p.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+
+
+def assert_identical(ref, out):
+    for name in ("probes.csv", "iterations.csv"):
+        a, b = read(os.path.join(ref, name)), read(os.path.join(out, name))
+        assert a == b, f"{name} differs from the uninterrupted run ({len(a)} vs {len(b)} bytes)"
+
+
+# ------------------------------------------------------------------------------ resume
+RESUME_CASES = {
+    # name: (scene, overrides, kill after this many rows, seconds allowed)
+    "sdof_model": ("sdof_model.yaml", ["time.end=40", "time.checkpoint_every=100", "coupling.gamma_n1=10"], 1450, 60),
+    "added_mass_aitken": ("added_mass.yaml", ["time.end=20", "time.checkpoint_every=100", "coupling.acceleration=aitken",
+                                              "coupling.relaxation=0.5"], 1250, 60),
+    "thick_beam": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10"], 27, 240),
+    "fsi3_iqn": ("fsi3.yaml", FSI3_COARSE + ["time.end=0.05", "time.checkpoint_every=6"], 9, 400),
+}
+
+
+def resume_case(env, name, how):
+    scene, sets, kill_at, limit = RESUME_CASES[name]
+    ref, out = env.out(f"{name}_ref"), env.out(f"{name}_cut")
+    t0 = time.time()
+    code, log = finish(launch(env, scene, ref, sets), limit)
+    assert code == 0, log[-2000:]
+    t_ref = time.time() - t0
+    p = launch(env, scene, out, sets)
+    wait_rows(os.path.join(out, "probes.csv"), kill_at, p, limit)
+    if how == "kill -9 coupler":
+        process_named(out, "coupler").kill()
+        code, log = finish(p, 15)
+        s = assert_final(out, "failed", 1, code)
+        assert "coupler was killed by SIGKILL" in s["reason"], s["reason"]
+    else:
+        p.send_signal(signal.SIGINT)
+        code, log = finish(p, 30)
+        s = assert_final(out, "interrupted", 130, code)
+    assert_no_leftovers(out)
+    cut = s["steps"]
+    code, log = finish(launch(env, scene, out, sets, extra=("--resume",)), limit)
+    assert code == 0, log[-2000:]
+    s = assert_final(out, "completed")
+    assert_identical(ref, out)
+    print(f"{name}: stopped ({how}) after {cut} steps, resumed from step {s['resumed_from_step']}: probes.csv and "
+          f"iterations.csv byte-identical to the uninterrupted run ({rows(os.path.join(ref, 'probes.csv'))} rows, "
+          f"reference {t_ref:.1f} s); checkpoints written {s['checkpoints']['written']}, "
+          f"{s['checkpoints']['last_bytes']} bytes each, {s['wall_time'].get('checkpoint', 0):.4f} s")
+
+
+def resume_small(env):
+    resume_case(env, "sdof_model", "kill -9 coupler")
+    resume_case(env, "added_mass_aitken", "SIGINT")
+
+
+def resume_thick_beam(env):
+    resume_case(env, "thick_beam", "kill -9 coupler")
+
+
+def resume_fsi3(env):
+    resume_case(env, "fsi3_iqn", "SIGINT")
+
+
+def resume_refused(env):
+    """--resume refuses a different scene, naming the keys; a non-empty --out is refused
+    without --resume or --force."""
+    sets = ["time.end=2", "time.checkpoint_every=20"]
+    out = env.out("refused")
+    code, log = env.fsi("sdof_model.yaml", out, *sets)
+    assert code == 0, log
+    code, log = env.fsi("sdof_model.yaml", out, *sets)
+    assert code == 1 and "is not empty" in log and "--resume" in log and "--force" in log, log
+    code, log = env.fsi("sdof_model.yaml", out, *sets, "coupling.gamma_n1=5", "solid.mass=2", extra=("--resume",))
+    assert code == 1 and "coupling.gamma_n1: 10 (checkpoint) vs 5 (now)" in log and "solid.mass" in log, log
+    # The same value written differently (1 for 1.0) is the same scene: no refusal.
+    code, log = env.fsi("sdof_model.yaml", out, *sets, "solid.mass=1", extra=("--resume",))
+    assert code == 0, log
+    code, log = env.fsi("sdof_model.yaml", out, *sets, extra=("--force",))
+    assert code == 0 and summary(out)["status"] == "completed", log
+    empty = env.out("no_checkpoints")
+    code, log = env.fsi("sdof_model.yaml", empty, "time.end=1")
+    code, log = env.fsi("sdof_model.yaml", empty, "time.end=1", extra=("--resume",))
+    assert code == 1 and "no complete checkpoint" in log, log
+    print("refused: non-empty --out, a changed scene (keys named), --resume without checkpoints")
+
+
+# ------------------------------------------------------------------------------ recovery
+RECOVER_SETS = ["time.end=2", "time.checkpoint_every=5"]
+
+
+def recovery_trials(env, victim, how, trials, seed):
+    """thick_beam (T = 2, a checkpoint every 5 steps): the victim server is killed (or
+    stopped) at a random step; the run must recover and end identical to the uninterrupted one."""
+    ref = env.out("recover_ref")
+    if not os.path.exists(os.path.join(ref, "probes.csv")):
+        code, log = finish(launch(env, "thick_beam.yaml", ref, RECOVER_SETS), 300)
+        assert code == 0, log[-2000:]
+    rng = random.Random(seed)
+    total = rows(os.path.join(ref, "probes.csv"))
+    for trial in range(trials):
+        at = rng.randint(3, total - 5)
+        out = env.out(f"recover_{victim}_{how}_{trial}")
+        extra = ("--timeout", "3") if how == "stop" else ()
+        p = launch(env, "thick_beam.yaml", out, RECOVER_SETS, extra)
+        wait_rows(os.path.join(out, "probes.csv"), at, p, 300)
+        server = server_of(p, victim)
+        server.send_signal(signal.SIGKILL if how == "kill" else signal.SIGSTOP)
+        code, log = finish(p, 300)
+        s = assert_final(out, "completed", 0, code)
+        rec = s.get("recoveries", [])
+        assert len(rec) == 1 and rec[0]["process"] == f"{victim}_server", rec
+        assert_identical(ref, out)
+        assert_no_leftovers(out)
+        if how == "stop":
+            try:
+                server.send_signal(signal.SIGKILL)
+            except psutil.Error:
+                pass
+        print(f"{victim} {how} at row {at}: recovered ({rec[0]['cause']}, resumed from step "
+              f"{rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv identical")
+
+
+# The test runs a few trials; the acceptance benchmark (bench/fsi/recovery_trials.sh) sets
+# FSI_RECOVERY_TRIALS=10.
+TRIALS = int(os.environ.get("FSI_RECOVERY_TRIALS", "0"))
+
+
+def recover_kill(env):
+    recovery_trials(env, "fluid", "kill", TRIALS or 2, 1)
+    recovery_trials(env, "solid", "kill", TRIALS or 2, 2)
+
+
+def recover_stop(env):
+    recovery_trials(env, "fluid", "stop", TRIALS or 1, 3)
+    recovery_trials(env, "solid", "stop", TRIALS or 1, 4)
+
+
+def recover_gives_up(env):
+    """A server that dies at every start: the launcher gives up after --recover N, failed."""
+    out = env.out("gives_up")
+    crash = env.out("crash_solid.sh")
+    with open(crash, "w") as f:
+        # Serves, then dies on its own a moment after the first coupler connects.
+        f.write(f"#!/bin/sh\n{env.exe('solid_server')} \"$@\" & pid=$!\nsleep 0.6; kill -9 $pid\n")
+    os.chmod(crash, 0o755)
+    t0 = time.time()
+    p = launch(env, "sdof_model.yaml", out, ["time.end=400", "time.checkpoint_every=50"],
+               ("--recover", "2", "--solid-command", crash))
+    code, log = finish(p, 60)
+    s = assert_final(out, "failed", 1, code)
+    assert "gave up after 2 recoveries" in s["reason"] and len(s["recoveries"]) == 2, (s["reason"], s.get("recoveries"))
+    assert_no_leftovers(out)
+    print(f"gave up after 2 recoveries in {time.time() - t0:.1f} s: {s['reason']}")
+
+
+# ------------------------------------------------------------------------------ exit paths
+def exit_paths(env):
+    """0 completed, 2 diverged, 1 failed (bad key, missing file, bad option, dead peer),
+    130 interrupted (SIGINT, SIGTERM; coupled and standalone); the summary is always final."""
+    out = env.out("x_completed")
+    code, _ = env.fsi("sdof_model.yaml", out)
+    assert_final(out, "completed", 0, code)
+    out = env.out("x_diverged")
+    code, _ = env.fsi("added_mass.yaml", out, "coupling.relaxation=0.5")
+    assert_final(out, "diverged", 2, code)
+    out = env.out("x_bad_key")
+    code, log = env.fsi("sdof_model.yaml", out, "coupling.relaxatoin=0.5")
+    assert code == 1 and "relaxatoin" in log, log
+    code, log = env.run([env.exe("fsi"), "run", env.out("missing.yaml"), "--out", env.out("x_missing")])
+    assert code == 1 and "missing.yaml" in log, (code, log)
+    code, log = env.run([env.exe("fsi"), "run", env.config("sdof_model.yaml"), "--no-such-option"])
+    assert code == 1, (code, log)
+    for exe in ("coupler", "solid_server", "fluid_server"):
+        code, log = env.run([env.exe(exe), "--no-such-option"])
+        assert code == 1, (exe, code, log)
+    # A dead peer without recovery.
+    out = env.out("x_dead_peer")
+    p = launch(env, "sdof_model.yaml", out, ["time.end=4000"], ("--recover", "0"))
+    wait_rows(os.path.join(out, "probes.csv"), 50, p, 20)
+    server_of(p, "fluid").kill()
+    code, log = finish(p, 20)
+    s = assert_final(out, "failed", 1, code)
+    assert "fluid server" in s["reason"], s["reason"]
+    assert_no_leftovers(out)
+    # Signals, coupled and standalone.
+    for scene, sets, label in (("sdof_model.yaml", ["time.end=4000"], "coupled"),
+                               ("csm3.yaml", ["time.end=1000", "time.output_every=0"], "standalone")):
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            out = env.out(f"x_{label}_{sig.name}")
+            p = launch(env, scene, out, sets)
+            wait_rows(os.path.join(out, "probes.csv"), 5, p, 60)
+            p.send_signal(sig)
+            code, log = finish(p, 20)
+            s = assert_final(out, "interrupted", 130, code)
+            assert sig.name in s["reason"] or "signal" in s["reason"], s["reason"]
+            assert_no_leftovers(out)
+    print("exit codes: completed 0, diverged 2, failed 1 (bad key, missing file, bad option, dead peer), "
+          "interrupted 130 (SIGINT/SIGTERM, coupled and standalone); summaries final, steps = probes rows")
+
+
+def coupler_death(env):
+    """kill -9 of the coupler: the launcher says so at once, stops both servers together in
+    under a second, leaves a final summary; --resume continues the run."""
+    out = env.out("coupler_death")
+    sets = ["time.end=60", "time.checkpoint_every=100"]
+    p = launch(env, "sdof_model.yaml", out, sets)
+    wait_rows(os.path.join(out, "probes.csv"), 300, p, 20)
+    coupler = process_named(out, "coupler")
+    t0 = time.time()
+    coupler.kill()
+    code, log = finish(p, 10)
+    elapsed = time.time() - t0
+    s = assert_final(out, "failed", 1, code)
+    assert "SIGKILL" in s["reason"] and "coupler" in log, (s["reason"], log[-500:])
+    assert elapsed < 1.5, f"the launcher took {elapsed:.2f} s to stop after the coupler died"
+    assert_no_leftovers(out)
+    code, log = finish(launch(env, "sdof_model.yaml", out, sets, ("--resume",)), 60)
+    assert code == 0, log[-1500:]
+    assert_final(out, "completed")
+    print(f"coupler killed: launcher ended in {elapsed:.2f} s; resumed and completed")
+
+
+def orphan_servers(env):
+    """Servers started by the launcher exit when the launcher itself is killed."""
+    out = env.out("orphans")
+    p = launch(env, "sdof_model.yaml", out, ["time.end=4000"])
+    wait_rows(os.path.join(out, "probes.csv"), 20, p, 20)
+    p.kill()  # the launcher only: its children are in their own process groups
+    p.wait(timeout=5)
+    assert_no_leftovers(out, timeout=5)
+    print("launcher killed: no process outlived it")
+
+
+if __name__ == "__main__":
+    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fsi3, resume_refused, recover_kill,
+                                  recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers)})
