@@ -359,6 +359,34 @@ std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
   return probes;
 }
 
+void FemSolid::save_state(StateArchive& state) {
+  state.put("solid.scheme", static_cast<std::int64_t>(scheme_));
+  state.put("solid.accepted_steps", static_cast<std::int64_t>(accepted_steps_));
+  state.put("solid.d_n", d_n_);
+  state.put("solid.v_n", v_n_);
+  state.put("solid.a_n", a_n_);
+  state.put("solid.f_n", f_n_);
+  state.put("solid.d_nm1", d_nm1_);
+  state.put("solid.v_nm1", v_nm1_);
+}
+
+void FemSolid::load_state(const StateArchive& state) {
+  if (!system_) throw SolverError("solid: load_state before configure");
+  if (state.integer("solid.scheme") != static_cast<std::int64_t>(scheme_))
+    throw StateError(fmt::format("solid checkpoint: entry 'solid.scheme' is {}, this configuration uses {}",
+                                 state.integer("solid.scheme"), static_cast<int>(scheme_)));
+  const Eigen::Index n = d_n_.size();
+  d_n_ = state.vector("solid.d_n", n);
+  v_n_ = state.vector("solid.v_n", n);
+  a_n_ = state.vector("solid.a_n", n);
+  f_n_ = state.vector("solid.f_n", n);
+  d_nm1_ = state.vector("solid.d_nm1", n);
+  v_nm1_ = state.vector("solid.v_nm1", n);
+  accepted_steps_ = static_cast<int>(state.integer("solid.accepted_steps"));
+  d_ = d_n_, v_ = v_n_, a_ = a_n_, f_ = f_n_;
+  solved_ = false;
+}
+
 std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
   if (!series_ || info.step % output_every_ != 0) return {};
   VtkGrid grid;

@@ -46,6 +46,10 @@ class FemSolid : public fsi::SolidModel {
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
+  // Checkpoints: the accepted state and the integrator's history (solid.*).
+  bool supports_checkpoint() const override { return true; }
+  void save_state(StateArchive& state) override;
+  void load_state(const StateArchive& state) override;
 
   // State access (tests, benchmarks).
   const SolidSystem& system() const { return *system_; }
