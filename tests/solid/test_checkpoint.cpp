@@ -110,3 +110,26 @@ TEST(SolidCheckpoint, StateOfAnotherMeshOrSchemeIsRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+// A huge or non-finite interface force must not be reported as a converged solve.
+TEST(SolidOverflow, HugeInterfaceForceIsNotConverged) {
+  const fsi::Scene scene = fsi::Scene::parse(beam_scene("dynamic", "bdf1"), "beam.yaml");
+  for (double magnitude : {1e155, 1e200, 1e300}) {
+    auto a = make(scene, 0.01, 0.0);
+    Eigen::VectorXd f = force(a->interface(), 1, 1);
+    f[f.size() - 1] = magnitude;
+    try {
+      const auto r = a->solve_step({0.01, 0.01, 1, 1}, f);
+      ADD_FAILURE() << magnitude << ": solve_step returned (" << r.newton_iterations << " Newton iterations, |d| "
+                    << r.interface_displacement.norm() << ")";
+    } catch (const fsi::SolverError& e) {
+      const std::string what = e.what();
+      EXPECT_TRUE(what.find("Newton did not converge") != std::string::npos || what.find("inverted") != std::string::npos)
+          << what;
+    }
+  }
+}
+
+}  // namespace

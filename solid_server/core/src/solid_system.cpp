@@ -239,14 +239,17 @@ NewtonReport SolidSystem::solve(Eigen::VectorXd& d, const Eigen::VectorXd& f_ext
   NewtonReport rep;
   SparseMatrix K;
   Eigen::VectorXd r;
-  double f_norm = 0;
-  for (int i = 0; i < num_free(); ++i) f_norm += f_ext(free_dofs_[i]) * f_ext(free_dofs_[i]);
-  f_norm = std::sqrt(f_norm);
+  // stableNorm: a load of 1e155 must not overflow to inf in the squares (and then pass
+  // any relative test); a non-finite load or residual never counts as converged.
+  Eigen::VectorXd f_free(num_free());
+  for (int i = 0; i < num_free(); ++i) f_free(i) = f_ext(free_dofs_[i]);
+  const double f_norm = f_free.stableNorm();
   for (int it = 0; it <= options.max_iterations; ++it) {
     assemble(d, f_ext, t, K, r);
-    rep.residual = r.norm();
+    rep.residual = r.stableNorm();
     if (it == 0) rep.initial_residual = rep.residual;
     const double ref = std::max(rep.initial_residual, f_norm);
+    if (!std::isfinite(rep.residual) || !std::isfinite(ref)) return rep;  // not converged
     if (rep.residual <= options.residual_tolerance * ref || rep.residual == 0) {
       rep.converged = true;
       return rep;
@@ -264,8 +267,9 @@ NewtonReport SolidSystem::solve(Eigen::VectorXd& d, const Eigen::VectorXd& f_ext
     if (dd.norm() <= options.increment_tolerance * std::sqrt(d_norm)) {
       // Increment negligible: accept after one more residual evaluation.
       assemble(d, f_ext, t, K, r);
-      rep.residual = r.norm();
-      rep.converged = rep.residual <= std::sqrt(options.residual_tolerance) * std::max(rep.initial_residual, f_norm);
+      rep.residual = r.stableNorm();
+      rep.converged = std::isfinite(rep.residual) && d.allFinite() &&
+                      rep.residual <= std::sqrt(options.residual_tolerance) * std::max(rep.initial_residual, f_norm);
       return rep;
     }
   }
