@@ -135,14 +135,14 @@ RESUME_CASES = {
 }
 
 
-def resume_case(env, name, how):
+def resume_case(env, name, how, extra=()):
     scene, sets, kill_at, limit = RESUME_CASES[name]
     ref, out = env.out(f"{name}_ref"), env.out(f"{name}_cut")
     t0 = time.time()
-    code, log = finish(launch(env, scene, ref, sets), limit)
+    code, log = finish(launch(env, scene, ref, sets, extra), limit)
     assert code == 0, log[-2000:]
     t_ref = time.time() - t0
-    p = launch(env, scene, out, sets)
+    p = launch(env, scene, out, sets, extra)
     wait_rows(os.path.join(out, "probes.csv"), kill_at, p, limit)
     if how == "kill -9 coupler":
         process_named(out, "coupler").kill()
@@ -155,7 +155,7 @@ def resume_case(env, name, how):
         s = assert_final(out, "interrupted", 130, code)
     assert_no_leftovers(out)
     cut = s["steps"]
-    code, log = finish(launch(env, scene, out, sets, extra=("--resume",)), limit)
+    code, log = finish(launch(env, scene, out, sets, extra=(*extra, "--resume")), limit)
     assert code == 0, log[-2000:]
     s = assert_final(out, "completed")
     assert_identical(ref, out)
@@ -168,6 +168,10 @@ def resume_case(env, name, how):
 def resume_small(env):
     resume_case(env, "sdof_model", "kill -9 coupler")
     resume_case(env, "added_mass_aitken", "SIGINT")
+    # The Python example solid in place of solid_server saves and loads its own state.
+    solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
+    RESUME_CASES["python_solid"] = RESUME_CASES["sdof_model"]
+    resume_case(env, "python_solid", "SIGINT", ("--solid-command", solid))
 
 
 def resume_thick_beam(env):
