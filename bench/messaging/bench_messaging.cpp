@@ -166,7 +166,7 @@ class ChildServer {
       report(server.endpoint());
       // Idle timeout: a parent that vanished without Stop does not leave us behind.
       const bool clean = server.serve(
-          [&](const std::string& bytes, bool& stop) { return service->handle_bytes(bytes, stop); },
+          [&](const std::string& bytes, const std::string& peer, bool& stop) { return service->handle_bytes(bytes, stop, peer); },
           std::chrono::seconds(60));
       return clean ? 0 : 3;
     } catch (const std::exception& e) {

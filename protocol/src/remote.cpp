@@ -1,6 +1,9 @@
 #include "fsi/protocol/remote.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
 
 namespace fsi::protocol {
 
@@ -76,10 +79,25 @@ fsi::v1::Request configure_request(const ConfigSection& section, double dt, doub
   return r;
 }
 
+// host:pid:start, the same for both servers of one coupler.
+std::string session_name() {
+  static const std::string name = [] {
+    char host[256] = {0};
+    gethostname(host, sizeof host - 1);
+    return fmt::format("{}:{}:{}", host, getpid(),
+                       std::chrono::duration_cast<std::chrono::milliseconds>(
+                           std::chrono::system_clock::now().time_since_epoch())
+                               .count() %
+                           100000000);
+  }();
+  return name;
+}
+
 std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* supports_damping,
                   bool* supports_checkpoint, bool* supports_output) {
   fsi::v1::Request r;
   r.mutable_hello()->set_client_name("fsi coupler");
+  r.mutable_hello()->set_session(session_name());
   const auto reply = client.call(r);
   if (!reply.has_hello())
     throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " did not answer the handshake with hello");

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 
@@ -101,20 +102,44 @@ extern "C" void on_signal(int) { g_signalled = true; }
 
 }  // namespace
 
-fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop) {
+void Service::peer_gone(const std::string& peer) {
+  if (!session_open_ || peer != session_peer_) return;
+  logger("server")->warn("session '{}' of '{}' ended: its connection closed", session_id_, session_client_);
+  session_open_ = false;
+  reset();
+}
+
+fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop, const std::string& peer) {
   fsi::v1::Reply reply;
   reply.set_protocol_version(kProtocolVersion);
   reply.set_sequence(request.sequence());
   const auto start = std::chrono::steady_clock::now();
+  // The order of checks: the version, then the session, then the body.
   if (request.protocol_version() != kProtocolVersion) {
     set_error(reply, fsi::v1::Error::VERSION_MISMATCH,
               fmt::format("protocol version mismatch: request has {}, this server speaks {}",
                           request.protocol_version(), kProtocolVersion));
     return reply;
   }
+  if (session_open_ && peer != session_peer_) {
+    set_error(reply, fsi::v1::Error::BUSY,
+              fmt::format("this server is in session '{}' with '{}' (since {}); it serves one coupler at a time",
+                          session_id_, session_client_, session_since_));
+    return reply;
+  }
   if (request.body_case() == fsi::v1::Request::BODY_NOT_SET) {
     set_error(reply, fsi::v1::Error::MALFORMED, "request has no body");
     return reply;
+  }
+  if (request.body_case() == fsi::v1::Request::kHello) {
+    session_open_ = true;
+    session_peer_ = peer;
+    session_id_ = request.hello().session().empty() ? "unnamed" : request.hello().session();
+    session_client_ = request.hello().client_name().empty() ? "a client" : request.hello().client_name();
+    const auto now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%H:%M:%S", std::localtime(&now));
+    session_since_ = buf;
   }
   try {
     dispatch(request, reply, stop);
@@ -140,7 +165,7 @@ std::string Service::before_configure(const std::string& request) const {
   return fmt::format("'{}' on an unconfigured server: the last 'configure' failed ({})", request, configure_failure_);
 }
 
-std::string Service::handle_bytes(const std::string& bytes, bool& stop) {
+std::string Service::handle_bytes(const std::string& bytes, bool& stop, const std::string& peer) {
   fsi::v1::Request request;
   if (!request.ParseFromString(bytes)) {
     fsi::v1::Reply reply;
@@ -149,7 +174,7 @@ std::string Service::handle_bytes(const std::string& bytes, bool& stop) {
               fmt::format("message of {} bytes is not a fsi.v1.Request", bytes.size()));
     return reply.SerializeAsString();
   }
-  return handle(request, stop).SerializeAsString();
+  return handle(request, stop, peer).SerializeAsString();
 }
 
 // ---------------------------------------------------------------------------- solid
@@ -308,6 +333,7 @@ int run_server(Service& service, const std::string& endpoint, const std::string&
     std::filesystem::rename(tmp, port_file);
   }
   log->info("listening on {}", bound);
+  server.set_disconnect_handler([&](const std::string& peer) { service.peer_gone(peer); });
   server.set_frame_error_handler([](std::size_t frames) {
     fsi::v1::Reply reply;
     reply.set_protocol_version(kProtocolVersion);
@@ -319,8 +345,8 @@ int run_server(Service& service, const std::string& endpoint, const std::string&
   });
   const auto idle = std::chrono::milliseconds(static_cast<long>(idle_timeout_seconds * 1000));
   const bool clean = server.serve(
-      [&](const std::string& bytes, bool& stop) {
-        std::string reply = service.handle_bytes(bytes, stop);
+      [&](const std::string& bytes, const std::string& peer, bool& stop) {
+        std::string reply = service.handle_bytes(bytes, stop, peer);
         return reply;
       },
       idle, [] { return g_signalled.load(); });

@@ -189,6 +189,58 @@ def strict_protocol(env):
     assert server.wait(timeout=5) == 0
 
 
+def sessions(env):
+    """One coupler at a time: Hello opens a session; another client is answered BUSY naming
+    it; the session ends when its client's connection closes, and the next client must
+    configure again."""
+    from fsi.v1 import coupling_pb2 as pb
+    server, endpoint = env.start_server("solid")
+    ctx = zmq.Context.instance()
+
+    def client():
+        sock = ctx.socket(zmq.DEALER)
+        sock.setsockopt(zmq.LINGER, 0)
+        sock.setsockopt(zmq.RCVTIMEO, 5000)
+        sock.connect(endpoint)
+        return sock
+
+    def call(sock, seq, **body):
+        r = pb.Request(protocol_version=1, sequence=seq)
+        for k, v in body.items():
+            getattr(r, k).CopyFrom(v)
+        sock.send_multipart([b"", r.SerializeToString()])
+        reply = pb.Reply()
+        reply.ParseFromString(sock.recv_multipart()[-1])
+        return reply
+
+    with open(env.config("sdof_model.yaml")) as f:
+        text = f.read()
+    cfg = pb.Configure(dt=0.02, end_time=1, scene_text=text, scene_path="sdof_model.yaml", section="solid")
+    a, b = client(), client()
+    assert call(a, 1, hello=pb.Hello(client_name="coupler A", session="s-a")).hello.kind == pb.SERVER_KIND_SOLID
+    assert call(a, 2, configure=cfg).configure.interface_nodes == 1
+    for body in (dict(hello=pb.Hello(client_name="coupler B", session="s-b")), dict(configure=cfg)):
+        r = call(b, 1, **body)
+        assert r.WhichOneof("body") == "error" and r.error.code == pb.Error.BUSY, r
+        assert "session 's-a' with 'coupler A'" in r.error.message, r.error.message
+    print("  BUSY:", r.error.message)
+    a.close(0)
+    deadline = time.time() + 5
+    while True:
+        r = call(b, 2, hello=pb.Hello(client_name="coupler B", session="s-b"))
+        if r.WhichOneof("body") == "hello" or time.time() > deadline:
+            break
+        time.sleep(0.05)
+    assert r.WhichOneof("body") == "hello", f"session not released after its client left: {r}"
+    step = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[1.0, 0.0])
+    r = call(b, 3, solve_step=step)
+    assert r.error.code == pb.Error.BAD_SEQUENCE, r  # the old configuration went with its session
+    assert call(b, 4, configure=cfg).configure.interface_nodes == 1
+    assert call(b, 5, solve_step=step).WhichOneof("body") == "solid_step"
+    assert call(b, 6, stop=pb.Stop(reason="done")).WhichOneof("body") == "stop"
+    assert server.wait(timeout=5) == 0
+
+
 def added_mass(env):
     """Pure added mass over loopback: converges below the closed-form limit of beta and is
     reported as diverged above it, for Algorithm 1 and Algorithm 2 at several gamma."""
@@ -251,5 +303,5 @@ def interrupt(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, added_mass,
+    main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, sessions, added_mass,
                                   config_errors, interrupt)})

@@ -4,6 +4,8 @@
 
 #include <atomic>
 #include <cstring>
+#include <iterator>
+#include <map>
 #include <vector>
 
 namespace fsi::transport {
@@ -116,18 +118,57 @@ std::string Client::receive(std::chrono::milliseconds timeout) {
 
 struct Server::Impl {
   zmq::socket_t socket{context(), zmq::socket_type::router};
+  zmq::socket_t monitor;
+  bool have_monitor = false;
+  std::map<int, std::string> peer_of_fd;  // the connection (file descriptor) a peer's requests came on
 };
 
 Server::Server(const std::string& endpoint) : impl_(std::make_unique<Impl>()) {
   try {
     impl_->socket.set(zmq::sockopt::linger, 1000);
+    const std::string mon = "inproc://fsi-server-monitor-" + std::to_string(monitor_counter++);
+    if (zmq_socket_monitor(impl_->socket.handle(), mon.c_str(), ZMQ_EVENT_DISCONNECTED) == 0) {
+      impl_->monitor = zmq::socket_t(context(), zmq::socket_type::pair);
+      impl_->monitor.set(zmq::sockopt::linger, 0);
+      impl_->monitor.connect(mon);
+      impl_->have_monitor = true;
+    }
     impl_->socket.bind(endpoint);
   } catch (const zmq::error_t& e) {
     throw TransportError("cannot bind '" + endpoint + "': " + e.what());
   }
 }
 
-Server::~Server() = default;
+Server::~Server() {
+  if (impl_ && impl_->have_monitor) zmq_socket_monitor(impl_->socket.handle(), nullptr, 0);
+}
+
+// Reads the monitor's DISCONNECTED events (waiting up to `wait` for the first) and reports
+// the peers whose connection closed.
+void Server::drain_disconnects(std::chrono::milliseconds wait) {
+  if (!impl_->have_monitor) return;
+  while (true) {
+    zmq::pollitem_t item{impl_->monitor.handle(), 0, ZMQ_POLLIN, 0};
+    poll_items(&item, 1, wait);
+    if (!(item.revents & ZMQ_POLLIN)) return;
+    wait = std::chrono::milliseconds(0);
+    zmq::message_t event, address;
+    (void)impl_->monitor.recv(event, zmq::recv_flags::none);
+    if (event.more()) (void)impl_->monitor.recv(address, zmq::recv_flags::none);
+    std::uint16_t id = 0;
+    std::uint32_t value = 0;
+    if (event.size() >= 6) {
+      std::memcpy(&id, event.data(), sizeof(id));
+      std::memcpy(&value, static_cast<const char*>(event.data()) + 2, sizeof(value));
+    }
+    if (id != ZMQ_EVENT_DISCONNECTED) continue;
+    const auto it = impl_->peer_of_fd.find(static_cast<int>(value));
+    if (it == impl_->peer_of_fd.end()) continue;
+    const std::string peer = it->second;
+    impl_->peer_of_fd.erase(it);
+    if (disconnect_) disconnect_(peer);
+  }
+}
 
 std::string Server::endpoint() const { return impl_->socket.get(zmq::sockopt::last_endpoint); }
 
@@ -138,6 +179,7 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};
     poll_items(&item, 1, std::chrono::milliseconds(200));
     if (should_stop && should_stop()) return true;
+    drain_disconnects(std::chrono::milliseconds(0));
     if (!(item.revents & ZMQ_POLLIN)) {
       if (idle_timeout.count() > 0 && std::chrono::steady_clock::now() - last_activity > idle_timeout)
         return false;
@@ -153,6 +195,16 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     }
     last_activity = std::chrono::steady_clock::now();
     if (frames.size() < 2) continue;  // no identity: cannot answer
+    const std::string peer(static_cast<const char*>(frames[0].data()), frames[0].size());
+    const int fd = frames.back().get(ZMQ_SRCFD);
+    if (fd >= 0) {
+      for (auto it = impl_->peer_of_fd.begin(); it != impl_->peer_of_fd.end();)
+        it = it->second == peer && it->first != fd ? impl_->peer_of_fd.erase(it) : std::next(it);
+      impl_->peer_of_fd[fd] = peer;
+    }
+    // A closed connection whose event is still in flight must be seen before a new peer's
+    // request is judged (a restarted coupler): give the monitor a moment.
+    drain_disconnects(std::chrono::milliseconds(0));
     // Envelope = the identity and every frame up to and including the empty delimiter (if
     // there is one); exactly one payload frame must follow.
     std::size_t envelope = 1;
@@ -166,7 +218,7 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     std::string reply;
     if (payload_frames == 1) {
       const auto& payload = frames[envelope];
-      reply = handler(std::string(static_cast<const char*>(payload.data()), payload.size()), stop);
+      reply = handler(std::string(static_cast<const char*>(payload.data()), payload.size()), peer, stop);
     } else if (frame_error_) {
       reply = frame_error_(payload_frames);
     } else {

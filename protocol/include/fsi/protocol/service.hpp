@@ -16,14 +16,25 @@ namespace fsi::protocol {
 class Service {
  public:
   virtual ~Service() = default;
-  std::string handle_bytes(const std::string& request_bytes, bool& stop);
-  fsi::v1::Reply handle(const fsi::v1::Request& request, bool& stop);
+  // `peer` identifies the client's connection (transport); "" = the only client.
+  std::string handle_bytes(const std::string& request_bytes, bool& stop, const std::string& peer = "");
+  fsi::v1::Reply handle(const fsi::v1::Request& request, bool& stop, const std::string& peer = "");
+  // The connection of `peer` closed: its session, if it holds one, ends and the server
+  // forgets its configuration (the next coupler configures it again).
+  void peer_gone(const std::string& peer);
+  bool in_session() const { return session_open_; }
 
  protected:
   virtual void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) = 0;
   // "'solve_step' before 'configure'", naming the last Configure's failure if there was one.
   std::string before_configure(const std::string& request) const;
   std::string configure_failure_;
+  // Called when a session ends without Stop: drop the model.
+  virtual void reset() = 0;
+
+ private:
+  bool session_open_ = false;
+  std::string session_peer_, session_id_, session_client_, session_since_;
 };
 
 using fsi::SolidFactory;
@@ -35,6 +46,7 @@ class SolidService : public Service {
 
  protected:
   void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) override;
+  void reset() override { model_.reset(); }
 
  private:
   SolidFactory factory_;
@@ -50,6 +62,7 @@ class FluidService : public Service {
 
  protected:
   void dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) override;
+  void reset() override { model_.reset(); }
 
  private:
   FluidFactory factory_;

@@ -63,8 +63,9 @@ class Server {
   // The endpoint actually bound, with the port resolved ("tcp://127.0.0.1:43817").
   std::string endpoint() const;
 
-  // Handler returns the reply bytes; set `stop` to end serving after this reply.
-  using Handler = std::function<std::string(const std::string& request, bool& stop)>;
+  // Handler returns the reply bytes; set `stop` to end serving after this reply. `peer`
+  // identifies the connection the request came from (opaque bytes, stable while it lasts).
+  using Handler = std::function<std::string(const std::string& request, const std::string& peer, bool& stop)>;
   // Serves requests until a handler sets stop, or no request arrives for `idle_timeout`
   // (zero = wait forever), or `should_stop()` returns true (polled every 200 ms).
   // Returns false on idle timeout.
@@ -74,9 +75,15 @@ class Server {
   // (identity and empty delimiter); without one, such a message is dropped.
   using FrameErrorHandler = std::function<std::string(std::size_t payload_frames)>;
   void set_frame_error_handler(FrameErrorHandler h) { frame_error_ = std::move(h); }
+  // Called when the connection of a peer that sent requests closes (its process died or
+  // it disconnected), before the next request is handled.
+  using DisconnectHandler = std::function<void(const std::string& peer)>;
+  void set_disconnect_handler(DisconnectHandler h) { disconnect_ = std::move(h); }
 
  private:
+  void drain_disconnects(std::chrono::milliseconds wait);
   FrameErrorHandler frame_error_;
+  DisconnectHandler disconnect_;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
