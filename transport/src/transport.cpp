@@ -196,15 +196,18 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     last_activity = std::chrono::steady_clock::now();
     if (frames.size() < 2) continue;  // no identity: cannot answer
     const std::string peer(static_cast<const char*>(frames[0].data()), frames[0].size());
+    // A closed connection whose event is still in flight must be seen before a new peer's
+    // request is judged (a restarted coupler after its predecessor died): the first request
+    // of a new peer, while others are known, gives the monitor up to 100 ms.
+    bool known = false;
+    for (const auto& [f, p] : impl_->peer_of_fd) known = known || p == peer;
+    drain_disconnects(std::chrono::milliseconds(!known && !impl_->peer_of_fd.empty() ? 100 : 0));
     const int fd = frames.back().get(ZMQ_SRCFD);
     if (fd >= 0) {
       for (auto it = impl_->peer_of_fd.begin(); it != impl_->peer_of_fd.end();)
         it = it->second == peer && it->first != fd ? impl_->peer_of_fd.erase(it) : std::next(it);
       impl_->peer_of_fd[fd] = peer;
     }
-    // A closed connection whose event is still in flight must be seen before a new peer's
-    // request is judged (a restarted coupler): give the monitor a moment.
-    drain_disconnects(std::chrono::milliseconds(0));
     // Envelope = the identity and every frame up to and including the empty delimiter (if
     // there is one); exactly one payload frame must follow.
     std::size_t envelope = 1;
