@@ -232,6 +232,7 @@ struct Server {
   std::string command;  // external command ("" = ours)
   std::string endpoint;
   fs::path port_file, log;
+  std::string curve_keys;  // CURVE key folder ("" = none)
 };
 
 Child start_server(Server& s, const fs::path& bin, const std::string& bind, std::chrono::seconds timeout) {
@@ -239,9 +240,12 @@ Child start_server(Server& s, const fs::path& bin, const std::string& bind, std:
   fs::remove(s.port_file);
   Child c;
   if (s.command.empty()) {
-    c = spawn(server, {(bin / server).string(), "--bind", bind, "--port-file", s.port_file.string()}, s.log);
+    std::vector<std::string> argv{(bin / server).string(), "--bind", bind, "--port-file", s.port_file.string()};
+    if (!s.curve_keys.empty()) argv.insert(argv.end(), {"--curve-keys", s.curve_keys});
+    c = spawn(server, argv, s.log);
   } else {
-    const std::string shell = fmt::format("exec {} --bind '{}' --port-file '{}'", s.command, bind, s.port_file.string());
+    std::string shell = fmt::format("exec {} --bind '{}' --port-file '{}'", s.command, bind, s.port_file.string());
+    if (!s.curve_keys.empty()) shell += fmt::format(" --curve-keys '{}'", s.curve_keys);
     c = spawn(server + " (external)", {}, s.log, shell);
   }
   try {
@@ -254,7 +258,7 @@ Child start_server(Server& s, const fs::path& bin, const std::string& bind, std:
 }
 
 struct RunOptions {
-  std::string scene_path, out_dir, solid_command, fluid_command;
+  std::string scene_path, out_dir, solid_command, fluid_command, curve_keys;
   std::vector<std::string> overrides;
   double timeout = 600;
   bool resume = false, force = false;
@@ -327,7 +331,7 @@ int run(const RunOptions& o) {
       log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
     fs::create_directories(ports);
     for (const auto& [side, command] : {std::pair{std::string("solid"), o.solid_command}, {"fluid", o.fluid_command}}) {
-      Server s{side, command, "", ports / (side + ".port"), out / (side + "_server.log")};
+      Server s{side, command, "", ports / (side + ".port"), out / (side + "_server.log"), o.curve_keys};
       const std::size_t i = side == "solid" ? 0 : 1;
       children[i] = start_server(s, bin, "tcp://127.0.0.1:*", kPortFileWait);
       log->info("{} listening on {} (log: {})", children[i].name, s.endpoint, s.log.string());
@@ -342,6 +346,7 @@ int run(const RunOptions& o) {
       if (resume) argv.push_back("--resume");
       if (resume && attempts > 0) argv.push_back("--resume-or-restart");
       if (recover > 0) argv.push_back("--recoverable");
+      if (!o.curve_keys.empty()) argv.insert(argv.end(), {"--curve-keys", o.curve_keys});
       argv.insert(argv.end(), sets.begin(), sets.end());
       coupler = spawn("coupler", argv, "");
       bool forwarded = false;
@@ -486,6 +491,14 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--recover", o.recover,
                       "restart a server that dies or stops answering up to N times, resuming from the last "
                       "checkpoint (default: 3 when time.checkpoint_every > 0, else 0)");
+  run_cmd->add_option("--curve-keys", o.curve_keys,
+                      "encrypt and authenticate the connections with ZeroMQ CURVE, keys from `fsi keys DIR`")
+      ->check(CLI::ExistingDirectory);
+  auto* keys_cmd = app.add_subcommand(
+      "keys", "write a new CURVE key folder for servers and coupler that talk beyond loopback (proto/README.md)");
+  std::string keys_dir;
+  keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")
+      ->required();
   auto* study_cmd = app.add_subcommand("study", "run a parameter study (tools/fsi_study.py run; docs/studies.md)");
   std::string study_file, study_out = "runs/study";
   int jobs = 0;
@@ -502,6 +515,18 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (study_cmd->parsed()) return study(study_file, study_out, jobs);
+  if (keys_cmd->parsed()) {
+    if (fs::exists(fs::path(keys_dir) / "server.key_secret") || fs::exists(fs::path(keys_dir) / "coupler.key_secret")) {
+      fsi::logger("fsi")->error("{} already holds keys: remove them first or choose another folder", keys_dir);
+      return 1;
+    }
+    const std::string coupler = (self_dir() / "coupler").string();
+    std::vector<char*> args{const_cast<char*>(coupler.c_str()), const_cast<char*>("--generate-keys"),
+                            keys_dir.data(), nullptr};
+    execv(args[0], args.data());
+    fsi::logger("fsi")->error("cannot start {}: {}", coupler, std::strerror(errno));
+    return 1;
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {

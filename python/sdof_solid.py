@@ -21,6 +21,8 @@ import sys
 
 import yaml
 import zmq
+import zmq.auth
+from zmq.auth.thread import ThreadAuthenticator
 
 VERSION = 1
 
@@ -188,11 +190,22 @@ def main():
     parser.add_argument("--bind", default="tcp://127.0.0.1:5555")
     parser.add_argument("--port-file", default="")
     parser.add_argument("--proto-dir", default=None)
+    parser.add_argument("--curve-keys", default=None,
+                        help="ZeroMQ CURVE key folder made by `fsi keys DIR`")
     args = parser.parse_args()
     pb = find_proto(args.proto_dir)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
 
     socket = zmq.Context.instance().socket(zmq.REP)
+    if args.curve_keys:  # encrypted; only the clients whose *.key is in the folder
+        auth = ThreadAuthenticator(zmq.Context.instance())
+        auth.start()
+        auth.configure_curve(domain="*", location=args.curve_keys)
+        public, secret = zmq.auth.load_certificate(
+            os.path.join(args.curve_keys, "server.key_secret"))
+        socket.curve_secretkey = secret
+        socket.curve_publickey = public
+        socket.curve_server = True
     socket.bind(args.bind)
     endpoint = socket.getsockopt(zmq.LAST_ENDPOINT).decode()
     if args.port_file:

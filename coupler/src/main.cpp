@@ -7,11 +7,12 @@
 // Exit code: 0 completed, 2 diverged (the run's summary says why), 1 failed (also bad
 // options), 130 interrupted (SIGINT/SIGTERM); with --recoverable, 75 when a server died or
 // stopped answering (the launcher restarts it and resumes from the last checkpoint).
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -20,6 +21,7 @@
 #include "fsi/common/run_report.hpp"
 #include "fsi/coupling/coupler.hpp"
 #include "fsi/protocol/remote.hpp"
+#include "fsi/transport/transport.hpp"
 
 namespace {
 extern "C" void on_signal(int) { fsi::coupling::Coupler::interrupt_flag() = true; }
@@ -33,21 +35,50 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   double timeout = 600, connect_timeout = 20;
   bool resume = false, force = false, recoverable = false, fresh_start = false, out_ready = false;
+  std::string curve_keys, generate_keys;
   app.add_option("scene", scene_path, "scene file (configs/*.yaml)")->required();
-  app.add_option("--solid", solid_endpoint, "solid server endpoint, e.g. tcp://127.0.0.1:5555")->required();
-  app.add_option("--fluid", fluid_endpoint, "fluid server endpoint, e.g. tcp://127.0.0.1:5556")->required();
+  app.add_option("--solid", solid_endpoint, "solid server endpoint, e.g. tcp://127.0.0.1:5555")
+      ->required();
+  app.add_option("--fluid", fluid_endpoint, "fluid server endpoint, e.g. tcp://127.0.0.1:5556")
+      ->required();
   app.add_option("--out", out_dir, "output folder");
   app.add_option("--set", overrides, "override a scene key: dotted.key=value");
-  app.add_option("--timeout", timeout, "seconds to wait for any reply (a dead peer is detected at once)");
+  app.add_option("--timeout", timeout,
+                 "seconds to wait for any reply (a dead peer is detected at once)");
   app.add_option("--connect-timeout", connect_timeout, "seconds to wait for the handshake");
   app.add_flag("--resume", resume, "continue the run in --out from its newest complete checkpoint");
   app.add_flag("--force", force, "replace the results of an earlier run in --out");
-  app.add_flag("--recoverable", recoverable,
-               "exit with code 75 (instead of 1) when a server dies or stops answering, so that the "
-               "launcher can restart it and resume (fsi run --recover)");
+  app.add_flag(
+      "--recoverable", recoverable,
+      "exit with code 75 (instead of 1) when a server dies or stops answering, so that the "
+      "launcher can restart it and resume (fsi run --recover)");
   app.add_flag("--resume-or-restart", fresh_start,
                "with --resume: start again from step 0 when there is no checkpoint yet");
   app.add_flag("--out-ready", out_ready, "the launcher has prepared --out")->group("");
+  app.add_option("--curve-keys", curve_keys,
+                 "encrypt and authenticate with ZeroMQ CURVE: the folder made by `fsi keys DIR` "
+                 "(coupler.key_secret, "
+                 "server.key)");
+  app.add_option("--generate-keys", generate_keys,
+                 "write a new CURVE key folder and exit (what `fsi keys` runs)")
+      ->group("");
+  // `coupler --generate-keys DIR` needs no scene.
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--generate-keys") {
+      try {
+        fsi::transport::generate_curve_keys(argv[i + 1]);
+      } catch (const std::exception& e) {
+        fsi::logger("coupler")->error("{}", e.what());
+        return 1;
+      }
+      std::printf(
+          "CURVE keys written to %s: server.key, server.key_secret, coupler.key, "
+          "coupler.key_secret\n"
+          "  servers:  --curve-keys %s (needs server.key_secret and coupler.key)\n"
+          "  coupler:  --curve-keys %s (needs coupler.key_secret and server.key)\n",
+          argv[i + 1], argv[i + 1], argv[i + 1]);
+      return 0;
+    }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -67,9 +98,9 @@ int main(int argc, char** argv) {
   }
   try {
     if (!out_ready)
-      fsi::prepare_output_dir(out_dir, resume ? fsi::OutputMode::Resume
-                                     : force ? fsi::OutputMode::Force
-                                             : fsi::OutputMode::Fresh);
+      fsi::prepare_output_dir(out_dir, resume  ? fsi::OutputMode::Resume
+                                       : force ? fsi::OutputMode::Force
+                                               : fsi::OutputMode::Fresh);
   } catch (const std::exception& e) {
     log->error("{}", e.what());
     return 1;
@@ -85,7 +116,8 @@ int main(int argc, char** argv) {
           if (old.contains(key)) history[key] = old[key];
       }
     } catch (const std::exception& e) {
-      log->warn("the earlier summary.json does not parse ({}); its history is not carried over", e.what());
+      log->warn("the earlier summary.json does not parse ({}); its history is not carried over",
+                e.what());
     }
   }
   fsi::RunReport report(out_dir, *scene, "coupler");
@@ -97,8 +129,12 @@ int main(int argc, char** argv) {
   auto fill_times = [&](const fsi::coupling::Coupler* coupler) {
     auto& w = report.data()["wall_time"];
     w["total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (solid) w["solid_compute"] = solid->times().compute, w["solid_messaging"] = solid->times().messaging();
-    if (fluid) w["fluid_compute"] = fluid->times().compute, w["fluid_messaging"] = fluid->times().messaging();
+    if (solid)
+      w["solid_compute"] = solid->times().compute,
+      w["solid_messaging"] = solid->times().messaging();
+    if (fluid)
+      w["fluid_compute"] = fluid->times().compute,
+      w["fluid_messaging"] = fluid->times().messaging();
     if (coupler) w["coupler_mapping_relaxation"] = coupler->times().coupler;
     if (coupler && coupler->times().checkpoint > 0) w["checkpoint"] = coupler->times().checkpoint;
     if (solid && !solid->timings().empty()) w["solid_breakdown"] = solid->timings();
@@ -110,15 +146,19 @@ int main(int argc, char** argv) {
   // 3. Connect (handshake), run, stop the servers.
   try {
     const auto connect = std::chrono::milliseconds(static_cast<long>(connect_timeout * 1000));
+    const auto keys = curve_keys.empty() ? fsi::transport::CurveKeys{}
+                                         : fsi::transport::load_curve_keys(curve_keys, "coupler");
     const auto wait = std::chrono::milliseconds(static_cast<long>(timeout * 1000));
     solid = std::make_unique<fsi::protocol::RemoteSolid>(
-        std::make_unique<fsi::protocol::ProtocolClient>(solid_endpoint, "solid server", connect));
+        std::make_unique<fsi::protocol::ProtocolClient>(solid_endpoint, "solid server", connect,
+                                                        keys));
     fluid = std::make_unique<fsi::protocol::RemoteFluid>(
-        std::make_unique<fsi::protocol::ProtocolClient>(fluid_endpoint, "fluid server", connect));
+        std::make_unique<fsi::protocol::ProtocolClient>(fluid_endpoint, "fluid server", connect,
+                                                        keys));
     solid->client().set_timeout(wait);
     fluid->client().set_timeout(wait);
-    log->info("connected: solid '{}' at {}, fluid '{}' at {}", solid->name(), solid_endpoint, fluid->name(),
-              fluid_endpoint);
+    log->info("connected: solid '{}' at {}, fluid '{}' at {}", solid->name(), solid_endpoint,
+              fluid->name(), fluid_endpoint);
     report.data()["servers"] = {{"solid", {{"name", solid->name()}, {"endpoint", solid_endpoint}}},
                                 {"fluid", {{"name", fluid->name()}, {"endpoint", fluid_endpoint}}}};
     fsi::coupling::Coupler coupler(*solid, *fluid, *scene, out_dir);
@@ -148,14 +188,20 @@ int main(int argc, char** argv) {
   // A server that died or stopped answering: with --recoverable, leave the survivor running
   // and tell the launcher which one to restart.
   std::string lost, cause;
-  if (solid && !solid->client().failure().empty()) lost = "solid_server", cause = solid->client().failure();
-  if (fluid && !fluid->client().failure().empty()) lost = "fluid_server", cause = fluid->client().failure();
+  if (solid && !solid->client().failure().empty())
+    lost = "solid_server", cause = solid->client().failure();
+  if (fluid && !fluid->client().failure().empty())
+    lost = "fluid_server", cause = fluid->client().failure();
   if (outcome.status == "failed" && !lost.empty()) {
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    report.data()["lost_peer"] = {{"process", lost},
-                                  {"cause", cause == "died" ? "died" : cause == "timeout" ? "no answer (timeout)" : cause},
-                                  {"step", outcome.steps + 1},
-                                  {"wall_seconds", report.data().value("wall_time_earlier_segments", 0.0) + elapsed}};
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report.data()["lost_peer"] = {
+        {"process", lost},
+        {"cause", cause == "died"      ? "died"
+                  : cause == "timeout" ? "no answer (timeout)"
+                                       : cause},
+        {"step", outcome.steps + 1},
+        {"wall_seconds", report.data().value("wall_time_earlier_segments", 0.0) + elapsed}};
     if (recoverable) {
       report.set_status("failed", outcome.reason + " (the launcher will try to recover)");
       report.write();
@@ -176,7 +222,8 @@ int main(int argc, char** argv) {
     log->warn("could not stop the fluid server: {}", e.what());
   }
   if (outcome.status == "completed")
-    log->info("completed {} steps, {} coupling iterations; results in {}", outcome.steps, outcome.iterations, out_dir);
+    log->info("completed {} steps, {} coupling iterations; results in {}", outcome.steps,
+              outcome.iterations, out_dir);
   else
     log->error("{}: {}", outcome.status, outcome.reason);
   return outcome.exit_code();

@@ -4,6 +4,7 @@ import math
 import os
 import signal
 import subprocess
+import sys
 import time
 
 import zmq
@@ -302,6 +303,80 @@ def interrupt(env):
     print(f"interrupted after {s['steps']} steps; no process left")
 
 
+def curve(env):
+    """ZeroMQ CURVE beyond loopback: `fsi keys` makes the key folder; a server started with
+    --curve-keys serves the coupler holding the folder's client key, and refuses, with a
+    clear error on the client's side, a client without keys or with other keys."""
+    from fsi.v1 import coupling_pb2 as pb
+    keys, other = env.out("keys"), env.out("other")
+    for folder in (keys, other):
+        code, text = env.run([env.exe("fsi"), "keys", folder], timeout=20)
+        assert code == 0, text
+    for name in ("server.key", "server.key_secret", "coupler.key", "coupler.key_secret"):
+        assert os.path.exists(os.path.join(keys, name)), name
+    for name in ("server.key_secret", "coupler.key_secret"):
+        mode = os.stat(os.path.join(keys, name)).st_mode & 0o777
+        assert mode == 0o600, f"{name} has mode {oct(mode)}"
+    code, text = env.run([env.exe("fsi"), "keys", keys], timeout=20)
+    assert code == 1 and "already holds keys" in text, text
+
+    # pyzmq reads the same certificates (zmq.auth), so a Python coupler can talk to it.
+    import zmq.auth
+    server, endpoint = env.start_server("solid", ["--curve-keys", keys])
+    client_public, client_secret = zmq.auth.load_certificate(os.path.join(keys, "coupler.key_secret"))
+    server_public, _ = zmq.auth.load_certificate(os.path.join(keys, "server.key"))
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.setsockopt(zmq.RCVTIMEO, 5000)
+    sock.curve_publickey, sock.curve_secretkey, sock.curve_serverkey = client_public, client_secret, server_public
+    sock.connect(endpoint)
+    r = pb.Request(protocol_version=1, sequence=1, hello=pb.Hello(client_name="python", session="py"))
+    sock.send_multipart([b"", r.SerializeToString()])
+    reply = pb.Reply()
+    reply.ParseFromString(sock.recv_multipart()[-1])
+    assert reply.hello.kind == pb.SERVER_KIND_SOLID, reply
+    sock.close(0)
+
+    # The coupler without keys, with another folder's keys, and with a folder that does not exist.
+    fluid, fluid_endpoint = env.start_server("fluid")
+    base = [env.exe("coupler"), env.config("sdof_model.yaml"), "--solid", endpoint, "--fluid", fluid_endpoint,
+            "--connect-timeout", "5"]
+    for extra, expected in (([], "it requires CURVE authentication (--curve-keys)"),
+                            (["--curve-keys", other], "CURVE authentication failed with the keys of " + other),
+                            (["--curve-keys", env.out("none")], "is not a folder")):
+        start = time.time()
+        code, text = env.run(base + ["--out", env.out(f"refused{len(extra)}_{expected[:3]}")] + extra, timeout=30)
+        assert code == 1 and expected in text, (code, text)
+        print(f"  refused in {time.time() - start:.2f} s: {expected}")
+    env.kill(server)
+    env.kill(fluid)
+
+    # A whole run with keys, the Python example solid included: same numbers as without.
+    plain, secured = env.out("plain"), env.out("secured")
+    code, text = env.fsi("sdof_model.yaml", plain, extra=["--solid-command", f"{sys.executable} "
+                                                          f"{env.source}/python/sdof_solid.py --proto-dir {env.proto}"])
+    assert code == 0, text
+    code, text = env.fsi("sdof_model.yaml", secured, extra=["--curve-keys", keys, "--solid-command",
+                                                            f"{sys.executable} {env.source}/python/sdof_solid.py "
+                                                            f"--proto-dir {env.proto}"])
+    assert code == 0, text
+    with open(os.path.join(plain, "probes.csv")) as a, open(os.path.join(secured, "probes.csv")) as b:
+        assert a.read() == b.read(), "probes.csv differs with CURVE"
+    with open(os.path.join(secured, "fluid_server.log")) as f:
+        assert "CURVE: encrypted, 1 authorised client key(s)" in f.read()
+
+    # Beyond loopback without keys: the server says so.
+    log = env.out("open.log")
+    with open(log, "w") as f:
+        p = env.spawn([env.exe("solid_server"), "--bind", "tcp://0.0.0.0:*", "--port-file", env.out("open.port"),
+                       "--idle-timeout", "1"], stdout=f, stderr=subprocess.STDOUT)
+    p.wait(timeout=15)
+    with open(log) as f:
+        text = f.read()
+    assert "accepts any client that can reach it: use --curve-keys DIR" in text, text
+    print("  CURVE run identical to the plain one; open bind warned")
+
+
 if __name__ == "__main__":
     main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, sessions, added_mass,
-                                  config_errors, interrupt)})
+                                  config_errors, interrupt, curve)})

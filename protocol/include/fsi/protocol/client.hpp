@@ -26,7 +26,8 @@ class RemoteError : public std::runtime_error {
 class ProtocolClient {
  public:
   ProtocolClient(const std::string& endpoint, std::string peer_name,
-                 std::chrono::milliseconds timeout = std::chrono::minutes(10));
+                 std::chrono::milliseconds timeout = std::chrono::minutes(10),
+                 const transport::CurveKeys& keys = {});
   // Sends `request` (version and sequence are filled in) and returns the reply.
   // Throws transport::TransportError (timeout, lost peer) or RemoteError.
   fsi::v1::Reply call(fsi::v1::Request request);

@@ -8,6 +8,7 @@
 
 #include "fsi/common/solver_model.hpp"
 #include "fsi/common/standalone.hpp"
+#include "fsi/transport/transport.hpp"
 #include "fsi/v1/coupling.pb.h"
 
 namespace fsi::protocol {
@@ -17,7 +18,8 @@ class Service {
  public:
   virtual ~Service() = default;
   // `peer` identifies the client's connection (transport); "" = the only client.
-  std::string handle_bytes(const std::string& request_bytes, bool& stop, const std::string& peer = "");
+  std::string handle_bytes(const std::string& request_bytes, bool& stop,
+                           const std::string& peer = "");
   fsi::v1::Reply handle(const fsi::v1::Request& request, bool& stop, const std::string& peer = "");
   // The connection of `peer` closed: its session, if it holds one, ends and the server
   // forgets its configuration (the next coupler configures it again).
@@ -37,8 +39,8 @@ class Service {
   std::string session_peer_, session_id_, session_client_, session_since_;
 };
 
-using fsi::SolidFactory;
 using fsi::FluidFactory;
+using fsi::SolidFactory;
 
 class SolidService : public Service {
  public:
@@ -73,7 +75,9 @@ class FluidService : public Service {
 
 // Binds `endpoint`, writes the bound endpoint to `port_file` (if non-empty, atomically),
 // and serves until Stop, idle timeout, or SIGINT/SIGTERM. Returns the process exit code.
+// With CURVE `keys`, only authorised clients can connect.
 int run_server(Service& service, const std::string& endpoint, const std::string& port_file,
-               double idle_timeout_seconds, const std::string& log_name);
+               double idle_timeout_seconds, const std::string& log_name,
+               const transport::CurveKeys& keys = {});
 
 }  // namespace fsi::protocol

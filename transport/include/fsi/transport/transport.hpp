@@ -13,6 +13,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace fsi::transport {
 
@@ -31,10 +32,29 @@ class PeerLostError : public TransportError {
   using TransportError::TransportError;
 };
 
+// ZeroMQ CURVE (elliptic-curve encryption and authentication of every connection). Keys
+// are Z85 text (40 characters). A folder made by `fsi keys DIR` holds two ZPL certificates
+// per side, the format of pyzmq's zmq.auth: server.key / server.key_secret and
+// coupler.key / coupler.key_secret.
+struct CurveKeys {
+  std::string public_key, secret_key;   // this side's pair
+  std::string server_public_key;        // a client: the server it may talk to
+  std::vector<std::string> authorized;  // a server: the client public keys it accepts
+  std::string folder;                   // where they came from (for messages)
+  bool enabled() const { return !secret_key.empty(); }
+};
+// Reads the keys of one side ("server" or "coupler") from a `fsi keys` folder; a server
+// accepts the public keys of every *.key certificate in the folder but server.key. Throws TransportError
+// naming the file.
+CurveKeys load_curve_keys(const std::string& folder, const std::string& side);
+// Writes a new server and coupler key pair into `folder` (secret files mode 0600).
+void generate_curve_keys(const std::string& folder);
+
 class Client {
  public:
-  // `peer_name` names the peer in errors ("solid server").
-  Client(const std::string& endpoint, std::string peer_name);
+  // `peer_name` names the peer in errors ("solid server"). With `keys`, the connection is
+  // encrypted and the server must accept this client's key.
+  Client(const std::string& endpoint, std::string peer_name, const CurveKeys& keys = {});
   ~Client();
   Client(const Client&) = delete;
   Client& operator=(const Client&) = delete;
@@ -56,7 +76,8 @@ class Client {
 class Server {
  public:
   // `endpoint` e.g. "tcp://127.0.0.1:*" (a free port is picked) or "tcp://0.0.0.0:5555".
-  explicit Server(const std::string& endpoint);
+  // With `keys`, only clients whose public key is authorised can connect (ZAP handler).
+  explicit Server(const std::string& endpoint, const CurveKeys& keys = {});
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
@@ -65,7 +86,8 @@ class Server {
 
   // Handler returns the reply bytes; set `stop` to end serving after this reply. `peer`
   // identifies the connection the request came from (opaque bytes, stable while it lasts).
-  using Handler = std::function<std::string(const std::string& request, const std::string& peer, bool& stop)>;
+  using Handler =
+      std::function<std::string(const std::string& request, const std::string& peer, bool& stop)>;
   // Serves requests until a handler sets stop, or no request arrives for `idle_timeout`
   // (zero = wait forever), or `should_stop()` returns true (polled every 200 ms).
   // Returns false on idle timeout.
