@@ -3,6 +3,9 @@
 // with Newton: C_D within 0.01 %, C_L within 0.5 %, dp within 0.1 % in at most 6 solves.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "fsi/common/config.hpp"
 #include "fsi/fluid/navier_stokes_fluid.hpp"
 
@@ -68,6 +71,30 @@ TEST(DfgBenchmark, UnknownSceneKeyIsRejected) {
                                 {"fluid.mesh.size=0.08", "fluid.scheme=bdf3"});
   fsi::fluid::NavierStokesFluid model;
   EXPECT_THROW(model.configure(scene.section("fluid"), fsi::FluidSetup{}), fsi::ConfigError);
+}
+
+TEST(DfgBenchmark, GeoWithoutSurfaceNamesTheGeoNotTheCachedMesh) {
+  // gmsh meshes a .geo with lines only without complaint; the message must name the .geo
+  // (file and line of the scene key), not the cache file it wrote.
+  const auto dir = std::filesystem::temp_directory_path() / "fsi_fluid_test_nosurface";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream geo(dir / "lines_only.geo");
+    geo << "Point(1) = {0, 0, 0, h};\nPoint(2) = {1, 0, 0, h};\nLine(1) = {1, 2};\nPhysical Line(\"inlet\") = {1};\n";
+  }
+  auto scene = fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1.yaml",
+                                {"fluid.mesh.geo=" + (dir / "lines_only.geo").string(), "fluid.mesh.size=0.5",
+                                 "fluid.mesh.cache_dir=" + (dir / "cache").string()});
+  fsi::fluid::NavierStokesFluid model;
+  try {
+    model.configure(scene.section("fluid"), fsi::FluidSetup{});
+    FAIL() << "a .geo without a surface was accepted";
+  } catch (const fsi::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'fluid.mesh.geo'"), std::string::npos) << what;
+    EXPECT_NE(what.find("needs a plane surface"), std::string::npos) << what;
+    EXPECT_EQ(what.rfind("cache", 0), std::string::npos) << what;  // starts with the scene, not the cache
+  }
 }
 
 }  // namespace

@@ -81,7 +81,11 @@ std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<
   if (order != 1) cmd += fmt::format(" -order {}", order);
   for (const auto& [name, value] : parameters) cmd += fmt::format(" -setnumber {} {:.17g}", name, value);
   cmd += fmt::format(" '{}' -o '{}' > '{}' 2>&1", geo.string(), tmp.string(), log_file.string());
-  fsi::logger("fluid")->info("meshing {} ({})", geo.filename().string(), cmd);
+  std::string what;
+  for (const auto& [name, value] : parameters) what += fmt::format("{}{} = {:g}", what.empty() ? "" : ", ", name, value);
+  fsi::logger("fluid")->info("meshing {} with gmsh ({}{}; log {})", geo.filename().string(), what,
+                             order != 1 ? fmt::format(", order {}", order) : "", log_file.string());
+  fsi::logger("fluid")->debug("{}", cmd);
   const int rc = std::system(cmd.c_str());
   if (rc != 0 || !std::filesystem::exists(tmp))
     throw std::runtime_error(fmt::format("gmsh failed on '{}' (exit {}): {}\n{}", geo.string(), rc, cmd, read_text(log_file)));
@@ -119,7 +123,18 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     msh = mesh_geo(geo, parameters, cache, taylor_hood ? 2 : 1);
   }
   const auto domain = string_list(mesh_section, "domain");
-  FluidMesh mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
+  FluidMesh mesh;
+  try {
+    mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
+  } catch (const fsi::ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    if (mesh_section.has("file")) throw;
+    // The user wrote the .geo: name it, not the cache file gmsh wrote from it.
+    mesh_section.fail("geo", fmt::format("gmsh meshed it, but the mesh cannot be used ({}): a .geo needs a plane "
+                                         "surface and the physical groups of fluid.mesh.domain and the boundaries",
+                                         e.what()));
+  }
   if (taylor_hood && !mesh.quadratic()) {
     log->info("fluid: {} has 3-node triangles; the P2/P1 elements get straight edges (mesh with gmsh -order 2 for "
               "curved boundaries)", msh.string());
