@@ -40,10 +40,11 @@ namespace fs = std::filesystem;
 namespace {
 
 // Launcher limits: a server must write its port file within 10 s of starting and answer the
-// coupler's Hello within 10 s; at the end each process gets 3 s to exit after Stop, then
-// SIGTERM, then SIGKILL 0.5 s later.
+// coupler's Hello within 5 s; at the end each process gets 3 s to exit after Stop (1 s when
+// the run failed: a server that never answered got no Stop it could obey), then SIGTERM,
+// then SIGKILL 0.5 s later.
 constexpr std::chrono::seconds kPortFileWait{10};
-constexpr int kHelloWaitSeconds = 10;
+constexpr int kHelloWaitSeconds = 5;
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int sig) { g_signal = sig; }
@@ -430,7 +431,8 @@ int run(const RunOptions& o) {
     final_reason = e.what();
     code = g_signal ? 130 : 1;
   }
-  stop_all({&coupler, &children[0], &children[1]}, std::chrono::seconds(3));
+  stop_all({&coupler, &children[0], &children[1]},
+           code == 0 || code == 2 || code == 130 ? std::chrono::seconds(3) : std::chrono::seconds(1));
   fs::remove_all(ports);
   if (final_status.empty() && code != 0 && code != 1 && code != 2 && code != 130) {
     final_status = "failed";

@@ -377,6 +377,38 @@ def curve(env):
     print("  CURVE run identical to the plain one; open bind warned")
 
 
+def misbehaving_solid(env):
+    """An external solid that never answers Hello, never writes its port file, answers as
+    a fluid or with another protocol version: the launcher stops, names the cause, leaves
+    a final summary.json and no process behind, within its documented waits (port file
+    10 s, Hello 5 s, 1 s to exit after a failed run)."""
+    fake = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fake_solid.py")
+    expected = {"silent": "no reply from solid server", "noport": "did not report its endpoint within 10 s",
+                "wrongkind": "is a SERVER_KIND_FLUID server, expected a SERVER_KIND_SOLID server",
+                "oldversion": "speaks protocol version 7 (HelloReply.protocol_version), this coupler 1"}
+    for mode, text in expected.items():
+        out = env.out(mode)
+        start = time.time()
+        code, log = env.fsi("sdof_model.yaml", out, timeout=60,
+                            extra=["--solid-command", f"{sys.executable} {fake} --mode {mode} --proto-dir {env.proto}"])
+        elapsed = time.time() - start
+        assert code == 1, (mode, code, log)
+        s = summary(out)
+        assert s["status"] == "failed" and text in s["reason"], (mode, s)
+        assert text in log, (mode, log)
+        leftovers = []
+        for pid in os.listdir("/proc"):
+            if pid.isdigit():
+                try:
+                    with open(f"/proc/{pid}/cmdline", "rb") as f:
+                        if out.encode() in f.read():
+                            leftovers.append(pid)
+                except OSError:
+                    pass
+        assert not leftovers, (mode, leftovers)
+        print(f"  {mode}: exit 1 after {elapsed:.1f} s: {s['reason']}")
+
+
 if __name__ == "__main__":
     main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, sessions, added_mass,
-                                  config_errors, interrupt, curve)})
+                                  config_errors, interrupt, curve, misbehaving_solid)})
