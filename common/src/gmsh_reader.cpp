@@ -44,9 +44,7 @@ int dimension_of(int type) {
 // A line reader that remembers the line number for error messages.
 class LineReader {
  public:
-  explicit LineReader(const std::filesystem::path& path) : path_(path), in_(path) {
-    if (!in_) throw std::runtime_error(fmt::format("cannot open mesh file '{}'", path.string()));
-  }
+  LineReader(std::istream& in, const std::filesystem::path& path) : path_(path), in_(in) {}
   bool next(std::string& line) {
     while (std::getline(in_, line)) {
       ++number_;
@@ -67,7 +65,7 @@ class LineReader {
 
  private:
   std::filesystem::path path_;
-  std::ifstream in_;
+  std::istream& in_;
   int number_ = 0;
 };
 
@@ -234,7 +232,13 @@ bool GmshMesh::has_group(const std::string& name) const {
 }
 
 GmshMesh read_gmsh(const std::filesystem::path& path) {
-  LineReader reader(path);
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("cannot open mesh file '{}'", path.string()));
+  return read_gmsh(in, path);
+}
+
+GmshMesh read_gmsh(std::istream& in, const std::filesystem::path& path) {
+  LineReader reader(in, path);
   ReaderState state;
   std::string line;
   if (!reader.next(line) || line != "$MeshFormat")

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -30,5 +31,7 @@ struct GmshMesh {
 };
 
 GmshMesh read_gmsh(const std::filesystem::path& path);
+// The same from a stream (e.g. an in-memory mesh); `name` stands for the file in messages.
+GmshMesh read_gmsh(std::istream& in, const std::filesystem::path& name);
 
 }  // namespace fsi
