@@ -1,5 +1,7 @@
 #include "fsi/protocol/client.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 namespace fsi::protocol {
@@ -60,6 +62,10 @@ fsi::v1::Reply ProtocolClient::call(fsi::v1::Request request) {
   const double elapsed =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   wall_seconds_ += elapsed;
+  if (!(std::isfinite(reply.compute_seconds()) && reply.compute_seconds() >= 0))
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} answered '{}' with compute_seconds = {} (must be finite and >= 0)", peer_name_,
+                                  what, reply.compute_seconds()));
   compute_seconds_ += reply.compute_seconds();
   if (reply.has_error())
     throw RemoteError(reply.error().code(), fmt::format("{} failed on '{}': {}", peer_name_, what,

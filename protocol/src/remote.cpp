@@ -1,5 +1,8 @@
 #include "fsi/protocol/remote.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -23,6 +26,11 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
   const int n = mesh.coordinates_size() / 2;
   if (mesh.coordinates_size() % 2 != 0)
     throw std::invalid_argument("interface mesh: odd number of coordinates");
+  if (n == 0) throw std::invalid_argument("interface mesh: no nodes (coordinates is empty)");
+  for (int i = 0; i < mesh.coordinates_size(); ++i)
+    if (!std::isfinite(mesh.coordinates(i)))
+      throw std::invalid_argument(fmt::format("interface mesh: coordinate {} of node {} is not finite",
+                                              i % 2 ? "y" : "x", i / 2));
   data.coordinates.resize(n, 2);
   for (int i = 0; i < n; ++i) {
     data.coordinates(i, 0) = mesh.coordinates(2 * i);
@@ -33,18 +41,42 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
     for (int i = 0; i < n; ++i) data.node_ids.push_back(i);
   if (static_cast<int>(data.node_ids.size()) != n)
     throw std::invalid_argument(fmt::format("interface mesh: {} node ids for {} nodes", data.node_ids.size(), n));
+  {
+    auto ids = data.node_ids;
+    std::sort(ids.begin(), ids.end());
+    const auto dup = std::adjacent_find(ids.begin(), ids.end());
+    if (dup != ids.end()) throw std::invalid_argument(fmt::format("interface mesh: node id {} appears twice", *dup));
+  }
   if (mesh.segments_size() % 2 != 0) throw std::invalid_argument("interface mesh: odd number of segment indices");
   for (int s = 0; s < mesh.segments_size() / 2; ++s) {
     const int a = static_cast<int>(mesh.segments(2 * s)), b = static_cast<int>(mesh.segments(2 * s + 1));
     if (a >= n || b >= n)
       throw std::invalid_argument(fmt::format("interface mesh: segment {} refers to node {} of {}", s, std::max(a, b), n));
+    if (a == b) throw std::invalid_argument(fmt::format("interface mesh: segment {} joins node {} to itself", s, a));
     data.segments.push_back({a, b});
   }
   data.lumped_measure = to_eigen(mesh.lumped_measure());
   if (data.segments.empty() && data.lumped_measure.size() != n && n > 0)
     throw std::invalid_argument("interface mesh: a point interface needs one lumped_measure per node");
+  if (data.lumped_measure.size() != 0 && data.lumped_measure.size() != n)
+    throw std::invalid_argument(
+        fmt::format("interface mesh: {} lumped_measure values for {} nodes", data.lumped_measure.size(), n));
+  for (Eigen::Index i = 0; i < data.lumped_measure.size(); ++i)
+    if (!(std::isfinite(data.lumped_measure[i]) && data.lumped_measure[i] > 0))
+      throw std::invalid_argument(fmt::format("interface mesh: lumped_measure of node {} is {} (must be finite and "
+                                              "> 0: a negative measure turns Algorithm 2's damping into a source)",
+                                              i, data.lumped_measure[i]));
   data.initial_displacement = to_eigen(mesh.initial_displacement());
   data.initial_velocity = to_eigen(mesh.initial_velocity());
+  for (const auto& [what, v] : {std::pair<const char*, const Eigen::VectorXd*>{"initial_displacement",
+                                                                               &data.initial_displacement},
+                                {"initial_velocity", &data.initial_velocity}}) {
+    if (v->size() != 0 && v->size() != 2 * n)
+      throw std::invalid_argument(fmt::format("interface mesh: {} has {} values, expected 0 or {}", what, v->size(), 2 * n));
+    for (Eigen::Index i = 0; i < v->size(); ++i)
+      if (!std::isfinite((*v)[i]))
+        throw std::invalid_argument(fmt::format("interface mesh: {} of node {} is not finite", what, i / 2));
+  }
   return data;
 }
 
@@ -135,6 +167,26 @@ void expect(bool ok, const ProtocolClient& client, const char* what) {
   if (!ok) throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " answered with the wrong reply to " + what);
 }
 
+// GetInterface, checked: a valid mesh with the node count ConfigureReply announced.
+InterfaceMeshData get_interface(ProtocolClient& client, std::uint32_t configured_nodes) {
+  fsi::v1::Request g;
+  g.mutable_get_interface();
+  const auto reply = client.call(g);
+  expect(reply.has_interface(), client, "get_interface");
+  InterfaceMeshData data;
+  try {
+    data = interface_from_proto(reply.interface());
+  } catch (const std::invalid_argument& e) {
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT, fmt::format("{} sent an invalid {}", client.peer_name(), e.what()));
+  }
+  if (configured_nodes != 0 && configured_nodes != data.nodes())
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} announced {} interface nodes (ConfigureReply.interface_nodes) but its "
+                                  "interface mesh has {}",
+                                  client.peer_name(), configured_nodes, data.nodes()));
+  return data;
+}
+
 Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, std::size_t n, const ProtocolClient& client,
                         const char* what) {
   if (static_cast<std::size_t>(f.size()) != 2 * n)
@@ -155,6 +207,16 @@ std::map<std::string, double> accept_call(ProtocolClient& client, const StepInfo
   r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
   const auto reply = client.call(r);
   expect(reply.has_accept(), client, "accept_step");
+  for (const auto& [name, value] : reply.accept().probes())
+    if (name.empty() || name.find_first_of(",\"\n\r ") != std::string::npos)
+      throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                        fmt::format("{} sent a probe named '{}': probe names are column names of probes.csv "
+                                    "(non-empty, no commas, quotes or spaces)",
+                                    client.peer_name(), name));
+  for (const auto& [name, value] : reply.accept().timings())
+    if (!(std::isfinite(value) && value >= 0))
+      throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                        fmt::format("{} sent timing '{}' = {} (must be finite and >= 0)", client.peer_name(), name, value));
   timings = {reply.accept().timings().begin(), reply.accept().timings().end()};
   return {reply.accept().probes().begin(), reply.accept().probes().end()};
 }
@@ -174,6 +236,9 @@ std::string save_call(ProtocolClient& client, int step, double time) {
   r.mutable_save_checkpoint()->set_time(time);
   const auto reply = client.call(r);
   expect(reply.has_checkpoint(), client, "save_checkpoint");
+  if (reply.checkpoint().state().empty())
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} answered save_checkpoint of step {} with an empty state", client.peer_name(), step));
   return reply.checkpoint().state();
 }
 
@@ -207,12 +272,9 @@ void RemoteSolid::load_checkpoint(int step, double time, const std::string& byte
 void RemoteSolid::configure(const ConfigSection& section, const SolidSetup& setup) {
   auto r = configure_request(section, setup.dt, setup.end_time, setup.output_dir.string());
   r.mutable_configure()->set_interface_damping(setup.interface_damping);
-  expect(client_->call(r).has_configure(), *client_, "configure");
-  fsi::v1::Request g;
-  g.mutable_get_interface();
-  const auto reply = client_->call(g);
-  expect(reply.has_interface(), *client_, "get_interface");
-  interface_ = interface_from_proto(reply.interface());
+  const auto configured = client_->call(r);
+  expect(configured.has_configure(), *client_, "configure");
+  interface_ = get_interface(*client_, configured.configure().interface_nodes());
 }
 
 SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& force) {
@@ -256,12 +318,9 @@ void RemoteFluid::configure(const ConfigSection& section, const FluidSetup& setu
   auto r = configure_request(section, setup.dt, setup.end_time, setup.output_dir.string());
   r.mutable_configure()->set_nitsche_penalty(setup.nitsche_penalty);
   r.mutable_configure()->set_nitsche_symmetry(setup.nitsche_symmetry);
-  expect(client_->call(r).has_configure(), *client_, "configure");
-  fsi::v1::Request g;
-  g.mutable_get_interface();
-  const auto reply = client_->call(g);
-  expect(reply.has_interface(), *client_, "get_interface");
-  interface_ = interface_from_proto(reply.interface());
+  const auto configured = client_->call(r);
+  expect(configured.has_configure(), *client_, "configure");
+  interface_ = get_interface(*client_, configured.configure().interface_nodes());
 }
 
 namespace {

@@ -409,6 +409,34 @@ def misbehaving_solid(env):
         print(f"  {mode}: exit 1 after {elapsed:.1f} s: {s['reason']}")
 
 
+def bad_replies(env):
+    """The coupler checks every field of every reply: an external solid whose interface
+    mesh, step results, probes, timings, checkpoint or protocol version are wrong stops the
+    run naming the field (exit 1, failed; non-finite results: exit 2, diverged)."""
+    fake = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fake_solid.py")
+    cases = {
+        "negmeasure": (1, "lumped_measure of node 0 is -1 (must be finite and > 0"),
+        "nancoord": (1, "coordinate y of node 0 is not finite"),
+        "dupids": (1, "node id 0 appears twice"),
+        "nodecount": (1, "announced 3 interface nodes (ConfigureReply.interface_nodes) but its interface mesh has 1"),
+        "shortdisp": (1, "sent 1 values for 'interface_displacement', expected 2"),
+        "nandisp": (2, "sent a non-finite 'interface_displacement' at node 0"),
+        "commaprobe": (1, "sent a probe named 'd_x,d_y'"),
+        "nancompute": (1, "with compute_seconds = nan (must be finite and >= 0)"),
+        "emptystate": (1, "answered save_checkpoint of step 5 with an empty state"),
+        "badversion": (1, "version 2"),
+    }
+    for mode, (expected_code, text) in cases.items():
+        out = env.out(mode)
+        code, log = env.fsi("sdof_model.yaml", out, "time.end=0.2", "time.checkpoint_every=5", timeout=60,
+                            extra=["--recover", "0", "--solid-command",
+                                   f"{sys.executable} {fake} --mode {mode} --proto-dir {env.proto}"])
+        s = summary(out)
+        assert code == expected_code and text in s["reason"], (mode, code, s.get("reason"), log[-2000:])
+        assert s["status"] == ("diverged" if expected_code == 2 else "failed"), (mode, s)
+        print(f"  {mode}: exit {code}, {s['reason'][:140]}")
+
+
 if __name__ == "__main__":
     main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, sessions, added_mass,
-                                  config_errors, interrupt, curve, misbehaving_solid)})
+                                  config_errors, interrupt, curve, misbehaving_solid, bad_replies)})
