@@ -107,7 +107,7 @@ Request stop() {
 // A full solid sequence: 2 steps of 2 coupling iterations, checkpoint after step 1, reload.
 std::vector<std::string> solid_sequence(const std::string& scene, double damping, bool with_load = true) {
   fsi::protocol::SolidService service(fsi::models::make_solid_model, "seed");
-  Builder b{service};
+  Builder b{service, {}};
   b.send(hello());
   const double dt = 0.01;
   b.send(configure(scene, dt, damping));
@@ -136,7 +136,7 @@ std::vector<std::string> solid_sequence(const std::string& scene, double damping
 
 std::vector<std::string> fluid_sequence(const std::string& scene) {
   fsi::protocol::FluidService service(fsi::models::make_fluid_model, "seed");
-  Builder b{service};
+  Builder b{service, {}};
   b.send(hello());
   const double dt = 0.01;
   b.send(configure(scene, dt, 0, 10));
@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
       "  time_scheme: bdf1\n  clamp: [left]\n  interface: [top, bottom, right]\n  output_every: 2\n", 0.0));
   {  // out of order and invalid requests
     fsi::protocol::SolidService service(fsi::models::make_solid_model, "seed");
-    Builder b{service};
+    Builder b{service, {}};
     auto r = base(0);
     r.mutable_solve_step()->add_interface_force(1);
     b.send(r);
@@ -245,7 +245,7 @@ int main(int argc, char** argv) {
   write(fluid, "seed_surrogate_default", fluid_sequence("fluid: {model: surrogate, force: 2}\n"));
   {
     fsi::protocol::FluidService service(fsi::models::make_fluid_model, "seed");
-    Builder b{service};
+    Builder b{service, {}};
     auto r = base(0);
     r.mutable_initial_loads()->add_interface_displacement(1);
     b.send(r);

@@ -44,8 +44,16 @@ void apply_override(YAML::Node root, const std::string& assignment, const std::s
   chain.back()[parts.back()] = value;
 }
 
+// A scene is a few hundred nodes; aliases (*a) of nested anchors (&a) let a few lines name
+// 2^40 of them, and a walk over the tree visits every one (fuzz/corpus/fuzz_scene/regress_alias_bomb).
+constexpr std::size_t kMaxSceneNodes = 100000;
+
 // yaml-cpp keeps the last of two equal keys silently: refuse them, naming both lines.
-void check_duplicates(const YAML::Node& node, const std::string& path, const std::string& origin) {
+void check_duplicates(const YAML::Node& node, const std::string& path, const std::string& origin,
+                      std::size_t& visited) {
+  if (++visited > kMaxSceneNodes)
+    throw ConfigError(origin + ": the scene has more than " + std::to_string(kMaxSceneNodes) +
+                      " values (counting every use of an alias); is an anchor (&) used recursively?");
   if (node.IsMap()) {
     std::map<std::string, YAML::Mark> seen;
     for (const auto& kv : node) {
@@ -55,10 +63,11 @@ void check_duplicates(const YAML::Node& node, const std::string& path, const std
       if (!fresh)
         throw ConfigError(mark_string(origin, kv.first.Mark()) + ": duplicate key '" + full + "' (first at " +
                           mark_string(origin, it->second) + ")");
-      check_duplicates(kv.second, full, origin);
+      check_duplicates(kv.second, full, origin, visited);
     }
   } else if (node.IsSequence()) {
-    for (std::size_t i = 0; i < node.size(); ++i) check_duplicates(node[i], path + "[" + std::to_string(i) + "]", origin);
+    for (std::size_t i = 0; i < node.size(); ++i)
+      check_duplicates(node[i], path + "[" + std::to_string(i) + "]", origin, visited);
   }
 }
 
@@ -96,7 +105,8 @@ Scene Scene::parse(const std::string& text, const std::string& origin,
   }
   if (!scene.state_->root || scene.state_->root.IsNull()) scene.state_->root = YAML::Node(YAML::NodeType::Map);
   if (!scene.state_->root.IsMap()) throw ConfigError(origin + ": a scene must be a YAML map of sections");
-  check_duplicates(scene.state_->root, "", origin);
+  std::size_t visited = 0;
+  check_duplicates(scene.state_->root, "", origin, visited);
   for (const auto& o : overrides) apply_override(scene.state_->root, o, origin);
   return scene;
 }
