@@ -8,7 +8,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -80,6 +83,25 @@ std::vector<T> parse_numbers(LineReader& reader, const std::string& line, std::s
   return values;
 }
 
+// A number read as a double (entity and node records) that must be a whole number in the range
+// of T (a tag, a count): casting 7.7e9 to int is undefined behaviour.
+template <class T>
+T whole(LineReader& reader, double x, const char* what) {
+  if (!(x >= static_cast<double>(std::numeric_limits<T>::min()) &&
+        x < static_cast<double>(std::numeric_limits<T>::max()) + 1.0) ||  // exact for int and long
+      x != std::floor(x))
+    reader.fail(fmt::format("{} must be an integer, got {}", what, x));
+  return static_cast<T>(x);
+}
+
+// A count from a section header: >= 0. It is not trusted for reserving memory (a header
+// claiming 10^12 nodes in a 100-byte file must fail at the end of the file, not in the allocator).
+long checked_count(LineReader& reader, long n, const char* what) {
+  if (n < 0) reader.fail(fmt::format("{} must be >= 0, got {}", what, n));
+  return n;
+}
+constexpr long kReserveAtMost = 1 << 16;
+
 struct RawElement {
   int type;
   std::vector<long> nodes;  // gmsh node tags
@@ -122,10 +144,11 @@ void read_physical_names(LineReader& reader, ReaderState& state) {
 
 void read_nodes_v2(LineReader& reader, ReaderState& state) {
   const auto count = parse_numbers<long>(reader, reader.require("number of nodes"), 1, "a node count");
-  state.nodes.reserve(static_cast<std::size_t>(count[0]));
-  for (long i = 0; i < count[0]; ++i) {
+  const long n = checked_count(reader, count[0], "the node count");
+  state.nodes.reserve(static_cast<std::size_t>(std::min(n, kReserveAtMost)));
+  for (long i = 0; i < n; ++i) {
     const auto v = parse_numbers<double>(reader, reader.require("a node"), 4, "'id x y z'");
-    state.nodes.push_back({static_cast<long>(v[0]), Eigen::Vector2d(v[1], v[2])});
+    state.nodes.push_back({whole<long>(reader, v[0], "a node id"), Eigen::Vector2d(v[1], v[2])});
   }
   if (reader.require("$EndNodes") != "$EndNodes") reader.fail("expected $EndNodes");
 }
@@ -155,11 +178,12 @@ void read_entities_v4(LineReader& reader, ReaderState& state) {
       const auto v = parse_numbers<double>(reader, reader.require("an entity"), dim == 0 ? 5 : 8, "an entity");
       // point: tag x y z nphys phys...; others: tag minxyz maxxyz nphys phys... nbound ...
       const std::size_t at = dim == 0 ? 4 : 7;
-      const int tag = static_cast<int>(v[0]);
-      const int nphys = static_cast<int>(v[at]);
-      if (v.size() < at + 1 + static_cast<std::size_t>(nphys)) reader.fail("truncated entity record");
+      const int tag = whole<int>(reader, v[0], "an entity tag");
+      const int nphys = whole<int>(reader, v[at], "a physical tag count");
+      if (nphys < 0 || v.size() < at + 1 + static_cast<std::size_t>(nphys)) reader.fail("truncated entity record");
       auto& phys = state.entity_physicals[{dim, tag}];
-      for (int k = 0; k < nphys; ++k) phys.push_back(static_cast<int>(v[at + 1 + static_cast<std::size_t>(k)]));
+      for (int k = 0; k < nphys; ++k)
+        phys.push_back(whole<int>(reader, v[at + 1 + static_cast<std::size_t>(k)], "a physical tag"));
     }
   }
   if (reader.require("$EndEntities") != "$EndEntities") reader.fail("expected $EndEntities");
@@ -167,14 +191,15 @@ void read_entities_v4(LineReader& reader, ReaderState& state) {
 
 void read_nodes_v4(LineReader& reader, ReaderState& state) {
   const auto header = parse_numbers<long>(reader, reader.require("node block header"), 4, "'blocks nodes min max'");
-  state.nodes.reserve(static_cast<std::size_t>(header[1]));
+  state.nodes.reserve(static_cast<std::size_t>(std::min(checked_count(reader, header[1], "the node count"), kReserveAtMost)));
   for (long b = 0; b < header[0]; ++b) {
     const auto bh = parse_numbers<long>(reader, reader.require("an entity block"), 4, "'dim tag parametric n'");
-    const long n = bh[3];
+    const long n = checked_count(reader, bh[3], "the block's node count");
     const bool parametric = bh[2] != 0;
-    std::vector<long> tags(static_cast<std::size_t>(n));
+    std::vector<long> tags;
+    tags.reserve(static_cast<std::size_t>(std::min(n, kReserveAtMost)));
     for (long i = 0; i < n; ++i)
-      tags[static_cast<std::size_t>(i)] = parse_numbers<long>(reader, reader.require("a node tag"), 1, "a node tag")[0];
+      tags.push_back(parse_numbers<long>(reader, reader.require("a node tag"), 1, "a node tag")[0]);
     for (long i = 0; i < n; ++i) {
       const auto x = parse_numbers<double>(reader, reader.require("node coordinates"), parametric ? 4 : 3, "'x y z'");
       state.nodes.push_back({tags[static_cast<std::size_t>(i)], Eigen::Vector2d(x[0], x[1])});
