@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
     (void)root.get<std::string>("description", "");
     const auto time = scene.section("time");
     const double dt = time.get<double>("dt"), end = time.get<double>("end");
+    const int output_every = time.get<int>("output_every", 0);  // VTK: the same policy as fsi run
     const auto fluid = scene.section("fluid");
     if (fluid.get<std::string>("model") != "fem") fluid.fail("model", "fluid_run runs only the fem model");
 
@@ -65,11 +66,12 @@ int main(int argc, char** argv) {
     std::map<std::string, double> probes;
     const int steps = static_cast<int>(std::llround(end / dt));
     int iterations = 0;
+    if (output_every > 0) model.write_output(fsi::StepInfo{0.0, dt, 0, 0});  // the initial state
     for (int n = 1; n <= steps; ++n) {
       fsi::StepInfo info{n * dt, dt, n, 0};
       iterations += model.solve_step(info, zero, zero).nonlinear_iterations;
       probes = model.accept_step(info);
-      model.write_output(info);
+      if (output_every > 0 && n % output_every == 0) model.write_output(info);
       if (!csv.is_open()) {
         std::vector<std::string> cols{"time"};
         for (const auto& [k, _] : probes) cols.push_back(k);

@@ -40,6 +40,7 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     if (time.checkpoint_every > 0)
       log->warn("time.checkpoint_every: checkpoints are written by coupled runs only; this {} run writes none", section);
     setup_fn(time);
+    if (time.output_every > 0) model->write_output(StepInfo{0.0, time.dt, 0, 0});  // the initial state
     ProbeTable probes(out_dir / "probes.csv");
     Progress progress(runner, time.steps);
     for (int n = 1; n <= time.steps; ++n) {
@@ -139,7 +140,8 @@ int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const 
       [&](const TimeSettings& time) {
         const auto section = scene.section("solid");
         model = make_model(factory, section, "solid");
-        model->configure(section, SolidSetup{time.dt, time.end, 0.0, out_dir / "vtk"});
+        model->configure(section, SolidSetup{time.dt, time.end, 0.0,
+                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path()});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {
@@ -158,7 +160,8 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
       [&](const TimeSettings& time) {
         const auto section = scene.section("fluid");
         model = make_model(factory, section, "fluid");
-        model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0, out_dir / "vtk"});
+        model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0,
+                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path()});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <fstream>
+#include <regex>
 #include <stdexcept>
 
 namespace fsi {
@@ -52,20 +54,48 @@ void write_vtu(const std::filesystem::path& path, const VtkGrid& grid) {
   out << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
 }
 
+Eigen::MatrixXd plane_stress_tensor(const Eigen::MatrixX3d& s) {
+  Eigen::MatrixXd t = Eigen::MatrixXd::Zero(s.rows(), 9);
+  t.col(0) = s.col(0);  // xx
+  t.col(1) = s.col(2);  // xy
+  t.col(3) = s.col(2);  // yx
+  t.col(4) = s.col(1);  // yy
+  return t;
+}
+
+Eigen::VectorXd von_mises(const Eigen::MatrixX3d& s) {
+  Eigen::VectorXd v(s.rows());
+  for (Eigen::Index i = 0; i < s.rows(); ++i)
+    v[i] = std::sqrt(s(i, 0) * s(i, 0) - s(i, 0) * s(i, 1) + s(i, 1) * s(i, 1) + 3 * s(i, 2) * s(i, 2));
+  return v;
+}
+
 PvdSeries::PvdSeries(std::filesystem::path dir, std::string name)
     : dir_(std::move(dir)), name_(std::move(name)) {
   std::filesystem::create_directories(dir_);
+  // Continue the collection of an earlier segment of this run (resume).
+  std::ifstream in(dir_ / (name_ + ".pvd"));
+  const std::regex entry("<DataSet timestep=\"([^\"]+)\" part=\"0\" file=\"(" + name_ + "_([0-9]+)\\.vtu)\"/>");
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, entry)) entries_.push_back({std::stod(m[1]), std::stoi(m[3]), m[2]});
+  }
 }
 
 std::filesystem::path PvdSeries::write(double time, int step, const VtkGrid& grid) {
   const std::string file = fmt::format("{}_{:06d}.vtu", name_, step);
   write_vtu(dir_ / file, grid);
-  entries_.emplace_back(time, file);
-  std::ofstream pvd(dir_ / (name_ + ".pvd"));
-  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (const auto& [t, f] : entries_)
-    pvd << fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", t, f);
-  pvd << "</Collection>\n</VTKFile>\n";
+  std::erase_if(entries_, [&](const Entry& e) { return e.step >= step; });
+  entries_.push_back({time, step, file});
+  const auto path = dir_ / (name_ + ".pvd");
+  {
+    std::ofstream pvd(path.string() + ".tmp");
+    pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+    for (const auto& e : entries_)
+      pvd << fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
+    pvd << "</Collection>\n</VTKFile>\n";
+  }
+  std::filesystem::rename(path.string() + ".tmp", path);
   return dir_ / file;
 }
 

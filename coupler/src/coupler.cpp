@@ -1,4 +1,5 @@
 #include "fsi/coupling/coupler.hpp"
+#include "fsi/coupling/interface_output.hpp"
 
 #include <fmt/format.h>
 
@@ -131,6 +132,36 @@ RunOutcome Coupler::run(RunReport& report) {
     // 2. Initial state: the newest checkpoint (resume), or the scene's initial state and the
     //    predictor's F_0 = -F*(initial fluid state).
     const bool checkpoints = time.checkpoint_every > 0;
+    // Output: both solvers' VTK and the coupling interfaces, every time.output_every steps
+    // and at t = 0. A side that answers three requests without writing a file is named once
+    // (its section turns output off, or it cannot write any).
+    std::optional<InterfaceOutput> interface_output;
+    if (time.output_every > 0) interface_output.emplace(vtk_dir, solid_interface_, fluid_interface);
+    int output_requests = 0;
+    std::map<std::string, std::size_t> files_written{{"solid", 0}, {"fluid", 0}};
+    auto write_output = [&](const StepInfo& info, const InterfaceFields& fields) {
+      ++output_requests;
+      if (solid_.supports_output()) {
+        Timer t(solid_time);
+        files_written["solid"] += solid_.write_output(info).size();
+      }
+      if (fluid_.supports_output()) {
+        Timer t(fluid_time);
+        files_written["fluid"] += fluid_.write_output(info).size();
+      }
+      {
+        Timer t(coupler_time);
+        interface_output->write(info.time, info.step, fields);
+      }
+      if (output_requests == 3)
+        for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
+                                            std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
+          if (ok && files_written[side] == 0)
+            log->warn("time.output_every = {}: the {} '{}' wrote no VTK in {} requests (does its section turn "
+                      "output off? {})",
+                      time.output_every, side, who, output_requests,
+                      std::string(side) == "solid" ? "solid.output_every" : "fluid.output.vtk_every");
+    };
     if (checkpoints || resume_)
       for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_checkpoint(), solid_.name()},
                                           std::tuple{"fluid", fluid_.supports_checkpoint(), fluid_.name()}})
@@ -209,6 +240,12 @@ RunOutcome Coupler::run(RunReport& report) {
       Timer t(coupler_time);
       force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s);
       force_nm1 = force_n;
+      if (time.output_every > 0) {  // the initial state, t = 0
+        write_output(StepInfo{0.0, time.dt, 0, 0},
+                     InterfaceFields{d_s, v_s, force_n, map_.to_solid(loads.traction_force),
+                                     map_.to_solid(loads.velocity_integral), map_.to_fluid(d_s), map_.to_fluid(v_s),
+                                     loads.traction_force, loads.velocity_integral});
+      }
     }
     if (checkpoints)
       data["checkpoints"] = {{"every", time.checkpoint_every}, {"keep", time.checkpoint_keep}, {"written", 0},
@@ -367,10 +404,12 @@ RunOutcome Coupler::run(RunReport& report) {
       for (const auto& [name, v] : row)
         if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
       probes.add(t_np1, row);
-      if (time.output_every > 0 && n % time.output_every == 0) {
-        if (solid_.supports_output()) solid_.write_output(accepted);
-        if (fluid_.supports_output()) fluid_.write_output(accepted);
-      }
+      if (time.output_every > 0 && n % time.output_every == 0)
+        write_output(accepted, InterfaceFields{s_last.interface_displacement, s_last.interface_velocity, force_applied,
+                                               map_.to_solid(loads_last.traction_force),
+                                               map_.to_solid(loads_last.velocity_integral), d_f_last,
+                                               map_.to_fluid(s_last.interface_velocity), loads_last.traction_force,
+                                               loads_last.velocity_integral});
       accelerator.end_step();
       force_nm1 = force_n;
       force_n = force;

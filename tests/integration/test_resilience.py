@@ -352,6 +352,75 @@ def orphan_servers(env):
     print("launcher killed: no process outlived it")
 
 
+# ------------------------------------------------------------------------------ output
+def vtk_series(folder, name):
+    """The (time, file) entries of folder/name.pvd; every file must exist and parse."""
+    import xml.etree.ElementTree as ET
+    entries = [(float(d.get("timestep")), d.get("file"))
+               for d in ET.parse(os.path.join(folder, name + ".pvd")).getroot().iter("DataSet")]
+    for _, f in entries:
+        ET.parse(os.path.join(folder, f))
+    return entries
+
+
+def point_array(path, name):
+    import xml.etree.ElementTree as ET
+    for a in ET.parse(path).getroot().iter("DataArray"):
+        if a.get("Name") == name:
+            values = [float(x) for x in a.text.split()]
+            k = int(a.get("NumberOfComponents", "1"))
+            return [values[i:i + k] for i in range(0, len(values), k)]
+    raise AssertionError(f"{path} has no array '{name}'")
+
+
+def vtk_output(env):
+    """One output switch: time.output_every writes VTK of both solvers and of both coupling
+    interfaces, with a t = 0 snapshot; stress as a 3x3 tensor; the transpose mapping
+    conserves the interface force (sum over the solid's nodes = sum over the fluid's); a
+    resumed run continues the series with files byte-identical to the uninterrupted run's;
+    a solver section that turns output off is named."""
+    sets = ["time.end=0.4", "time.output_every=5", "time.checkpoint_every=5"]
+    ref, out = env.out("vtk_ref"), env.out("vtk_cut")
+    code, log = finish(launch(env, "thick_beam.yaml", ref, sets), 240)
+    assert code == 0, log[-2000:]
+    vtk = os.path.join(ref, "vtk")
+    for name in ("solid", "fluid", "interface_solid", "interface_fluid"):
+        entries = vtk_series(vtk, name)
+        steps = [int(f.rsplit("_", 1)[1].split(".")[0]) for _, f in entries]
+        assert steps == [0, 5, 10, 15, 20], (name, steps)
+        assert abs(entries[1][0] - 0.1) < 1e-12, entries
+    stress = point_array(os.path.join(vtk, "solid_000010.vtu"), "cauchy_stress")
+    assert len(stress[0]) == 9 and stress[0][1] == stress[0][3] and stress[0][8] == 0, stress[0]
+    for step in (5, 20):
+        fs = point_array(os.path.join(vtk, f"interface_solid_{step:06d}.vtu"), "traction_force_mapped")
+        ff = point_array(os.path.join(vtk, f"interface_fluid_{step:06d}.vtu"), "traction_force")
+        for c in (0, 1):
+            a, b = sum(r[c] for r in fs), sum(r[c] for r in ff)
+            # exact by construction (transpose mapping), to the files' 10 significant digits
+            assert abs(a - b) <= 1e-9 * (sum(abs(r[c]) for r in ff) + sum(abs(r[c]) for r in fs)), (step, c, a, b)
+        print(f"  step {step}: interface force, solid side {sum(r[0] for r in fs):.12e} {sum(r[1] for r in fs):.12e}, "
+              f"fluid side {sum(r[0] for r in ff):.12e} {sum(r[1] for r in ff):.12e}")
+    # Resumed: the series continue, files identical to the uninterrupted run's.
+    p = launch(env, "thick_beam.yaml", out, sets)
+    wait_rows(os.path.join(out, "probes.csv"), 12, p, 240)
+    p.send_signal(signal.SIGINT)
+    finish(p, 30)
+    code, log = finish(launch(env, "thick_beam.yaml", out, sets, extra=("--resume",)), 240)
+    assert code == 0, log[-2000:]
+    for name in ("solid", "fluid", "interface_solid", "interface_fluid"):
+        assert vtk_series(os.path.join(out, "vtk"), name) == vtk_series(vtk, name), name
+        for _, f in vtk_series(vtk, name):
+            assert read(os.path.join(vtk, f)) == read(os.path.join(out, "vtk", f)), f
+    print(f"  resumed from step {summary(out)['resumed_from_step']}: every .pvd and .vtu identical to the "
+          f"uninterrupted run's")
+    # A section that turns its solver's output off is named.
+    off = env.out("vtk_off")
+    code, log = finish(launch(env, "thick_beam.yaml", off, ["time.end=0.4", "time.output_every=5",
+                                                            "fluid.output={vtk_every: 0}"]), 240)
+    assert code == 0 and "wrote no VTK in 3 requests (does its section turn output off? fluid.output.vtk_every)" in log, log[-3000:]
+    print("  fluid.output.vtk_every: 0 named in a warning")
+
+
 if __name__ == "__main__":
     main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fsi3, resume_refused, recover_kill,
-                                  recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers)})
+                                  recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers, vtk_output)})

@@ -117,8 +117,14 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     if (!(parameters["h"] > 0)) mesh_section.fail("size", "must be positive");
     if (auto extra = mesh_section.optional_child("parameters"))
       for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
-    std::filesystem::path cache = setup.output_dir.empty() ? std::filesystem::temp_directory_path() / "fsi_fluid_meshes"
-                                                           : setup.output_dir / "meshes";
+    // One place for every run, so a mesh is made once: $FSI_MESH_CACHE, else
+    // $XDG_CACHE_HOME/fsi/meshes, else ~/.cache/fsi/meshes (entries keyed by a hash of the
+    // .geo text, its parameters and the element order).
+    std::filesystem::path cache;
+    if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env) cache = env;
+    else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) cache = std::filesystem::path(xdg) / "fsi" / "meshes";
+    else if (const char* home = std::getenv("HOME"); home && *home) cache = std::filesystem::path(home) / ".cache" / "fsi" / "meshes";
+    else cache = std::filesystem::temp_directory_path() / "fsi_fluid_meshes";
     if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
     msh = mesh_geo(geo, parameters, cache, taylor_hood ? 2 : 1);
   }
@@ -381,8 +387,13 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
           pd->fail(k, "unknown pressure probe '" + p + "'");
       pressure_differences_.push_back({k, {pair[0], pair[1]}});
     }
-  if (auto out = section.optional_child("output")) vtk_every_ = out->get<int>("vtk_every", 0);
-  if (vtk_every_ > 0 && !setup.output_dir.empty()) vtk_ = PvdSeries(setup.output_dir, "fluid");
+  // VTK whenever the run asks (time.output_every), unless output.vtk_every says otherwise:
+  // N > 0 = only at steps that are multiples of N, 0 = never.
+  if (auto out = section.optional_child("output")) {
+    vtk_every_ = out->get<int>("vtk_every", -1);
+    if (vtk_every_ < 0 && out->has("vtk_every")) out->fail("vtk_every", "must be >= 0 (0 = never)");
+  }
+  if (vtk_every_ != 0 && !setup.output_dir.empty()) vtk_ = PvdSeries(setup.output_dir, "fluid");
 
   log->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, mesh {}", element,
             taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(), fluid_mesh.triangle_count(), solver.dofs(),
@@ -530,7 +541,7 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
 }
 
 std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {
-  if (vtk_every_ <= 0 || setup_.output_dir.empty() || info.step % vtk_every_ != 0) return {};
+  if (vtk_every_ == 0 || setup_.output_dir.empty() || (vtk_every_ > 0 && info.step % vtk_every_ != 0)) return {};
   const auto mesh = solver_->mesh().linear_refinement();  // P2: 4 linear triangles per element
   VtkGrid grid;
   grid.points = solver_->positions();

@@ -403,7 +403,8 @@ std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
     stress.row(c) = k.J > 0 ? Eigen::RowVector3d(cauchy_stress(k, system_->material().stress(k)).transpose())
                             : Eigen::RowVector3d::Constant(NAN);
   }
-  grid.cell_data["cauchy_stress_xx_yy_xy"] = stress;
+  grid.cell_data["cauchy_stress"] = plane_stress_tensor(stress);  // 3x3, in-plane components (zz = 0)
+  grid.cell_data["von_mises_stress"] = von_mises(stress);
   return {series_->write(info.time, info.step, grid).string()};
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // ASCII VTK XML unstructured grids (.vtu) and a ParaView collection (.pvd) that grows one
-// entry per written step (rewritten each time so it is valid after a crash).
+// entry per written step (rewritten each time so it is valid after a crash). Arrays with 2
+// columns are written as 3-vectors (z = 0); 9 columns are a 3x3 tensor (row-major), which
+// ParaView shows as a tensor.
 #include <Eigen/Core>
 
 #include <filesystem>
@@ -10,7 +12,7 @@
 
 namespace fsi {
 
-enum class VtkCellType : int { Line = 3, Triangle = 5, Quad = 9 };
+enum class VtkCellType : int { Vertex = 1, Line = 3, Triangle = 5, Quad = 9 };
 
 struct VtkGrid {
   Eigen::MatrixXd points;                    // n x 2 or n x 3
@@ -22,17 +24,28 @@ struct VtkGrid {
 
 void write_vtu(const std::filesystem::path& path, const VtkGrid& grid);
 
+// The in-plane Cauchy stress (xx, yy, xy) per row as a 3x3 tensor per row (zz = 0).
+Eigen::MatrixXd plane_stress_tensor(const Eigen::MatrixX3d& xx_yy_xy);
+// Von Mises equivalent of the in-plane stress (plane stress formula).
+Eigen::VectorXd von_mises(const Eigen::MatrixX3d& xx_yy_xy);
+
 class PvdSeries {
  public:
   PvdSeries() = default;
-  // Files go to dir/<name>_<step>.vtu, the collection to dir/<name>.pvd.
+  // Files go to dir/<name>_<step>.vtu, the collection to dir/<name>.pvd. An existing
+  // collection (a resumed run) is continued: writing step k drops its entries of steps >= k.
   PvdSeries(std::filesystem::path dir, std::string name);
   std::filesystem::path write(double time, int step, const VtkGrid& grid);
 
  private:
   std::filesystem::path dir_;
   std::string name_;
-  std::vector<std::pair<double, std::string>> entries_;
+  struct Entry {
+    double time;
+    int step;
+    std::string file;
+  };
+  std::vector<Entry> entries_;
 };
 
 }  // namespace fsi

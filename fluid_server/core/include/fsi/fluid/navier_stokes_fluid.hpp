@@ -81,7 +81,7 @@ class NavierStokesFluid : public FluidModel {
   std::vector<ForceProbe> forces_;
   std::vector<std::pair<std::string, Eigen::Vector2d>> pressure_probes_;
   std::vector<std::pair<std::string, std::pair<std::string, std::string>>> pressure_differences_;
-  int vtk_every_ = 0;
+  int vtk_every_ = -1;  // -1: whenever asked
   PvdSeries vtk_;
   StepReport last_report_;
   double solve_seconds_ = 0;

@@ -1,0 +1,59 @@
+#include "fsi/coupling/interface_output.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace fsi::coupling {
+namespace {
+
+VtkGrid grid_of(const InterfaceMeshData& mesh) {
+  VtkGrid g;
+  g.points = mesh.coordinates;
+  if (mesh.segments.empty()) {
+    for (int i = 0; i < static_cast<int>(mesh.nodes()); ++i) {
+      g.cells.push_back({i});
+      g.cell_types.push_back(VtkCellType::Vertex);
+    }
+  } else {
+    for (const auto& s : mesh.segments) {
+      g.cells.push_back({s[0], s[1]});
+      g.cell_types.push_back(VtkCellType::Line);
+    }
+  }
+  return g;
+}
+
+Eigen::MatrixXd nodal(const Eigen::VectorXd& v, Eigen::Index n, const char* name) {
+  if (v.size() != 2 * n) throw std::invalid_argument(std::string("interface output: '") + name + "' has the wrong size");
+  Eigen::MatrixXd m(n, 2);
+  for (Eigen::Index i = 0; i < n; ++i) m.row(i) << v[2 * i], v[2 * i + 1];
+  return m;
+}
+
+}  // namespace
+
+InterfaceOutput::InterfaceOutput(const std::filesystem::path& vtk_dir, const InterfaceMeshData& solid,
+                                 const InterfaceMeshData& fluid)
+    : solid_grid_(grid_of(solid)),
+      fluid_grid_(grid_of(fluid)),
+      solid_series_(vtk_dir, "interface_solid"),
+      fluid_series_(vtk_dir, "interface_fluid") {}
+
+void InterfaceOutput::write(double time, int step, const InterfaceFields& f) {
+  const Eigen::Index ns = solid_grid_.points.rows(), nf = fluid_grid_.points.rows();
+  auto& s = solid_grid_.point_data;
+  s["displacement"] = nodal(f.solid_displacement, ns, "solid displacement");
+  s["velocity"] = nodal(f.solid_velocity, ns, "solid velocity");
+  s["force"] = nodal(f.solid_force, ns, "solid force");
+  s["traction_force_mapped"] = nodal(f.traction_mapped, ns, "mapped traction force");
+  s["velocity_integral_mapped"] = nodal(f.velocity_integral_mapped, ns, "mapped velocity integral");
+  auto& q = fluid_grid_.point_data;
+  q["displacement"] = nodal(f.fluid_displacement, nf, "fluid displacement");
+  q["velocity"] = nodal(f.fluid_velocity, nf, "fluid velocity");
+  q["traction_force"] = nodal(f.traction_force, nf, "traction force");
+  q["velocity_integral"] = nodal(f.velocity_integral, nf, "velocity integral");
+  solid_series_.write(time, step, solid_grid_);
+  fluid_series_.write(time, step, fluid_grid_);
+}
+
+}  // namespace fsi::coupling
