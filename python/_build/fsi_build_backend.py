@@ -18,6 +18,7 @@ import warnings
 def _setuptools():
     try:
         import setuptools.build_meta as backend  # noqa: F401
+        import wheel  # noqa: F401 - setuptools' bdist_wheel needs it
     except ImportError:
         # pip's isolated build environment removes the system site-packages from sys.path.
         for path in site.getsitepackages([sys.base_prefix]):
@@ -25,6 +26,7 @@ def _setuptools():
                 sys.path.append(path)
         try:
             import setuptools.build_meta as backend  # noqa: F811
+            import wheel  # noqa: F401
         except ImportError as e:
             raise RuntimeError("building fsi needs setuptools (Debian: apt-get install python3-setuptools "
                                "python3-wheel)") from e
