@@ -445,9 +445,21 @@ int run(const RunOptions& o) {
   return code;
 }
 
-// `fsi study`: hands the sweep to tools/fsi_study.py (Debian's python3), passing this executable
-// as --fsi so every run uses the same build. Replaces this process; returns only on failure.
-int study(const std::string& study_file, const std::string& out_dir, int jobs) {
+// The Python interpreter of the project's Python tools: $FSI_PYTHON, else the one CMake found
+// with numpy, yaml, zmq and protobuf (cmake/FsiPython.cmake).
+std::string python_interpreter() {
+  if (const char* env = std::getenv("FSI_PYTHON"); env && *env) return env;
+#ifdef FSI_PYTHON
+  return FSI_PYTHON;
+#else
+  return "/usr/bin/python3";
+#endif
+}
+
+// `fsi study`: hands the sweep to the study tool (tools/fsi_study.py) with every option after
+// the study file passed on unchanged, and this executable as --fsi so every run uses the same
+// build. Replaces this process; returns only on failure.
+int study(const std::vector<std::string>& study_args) {
 #ifdef FSI_SOURCE_DIR
   fs::path tool = fs::path(FSI_SOURCE_DIR) / "tools" / "fsi_study.py";
 #else
@@ -459,13 +471,15 @@ int study(const std::string& study_file, const std::string& out_dir, int jobs) {
     return 1;
   }
   const std::string self = fs::read_symlink("/proc/self/exe").string();
-  std::vector<std::string> args{"/usr/bin/python3", tool.string(), "run", study_file, "--out", out_dir, "--fsi", self};
-  if (jobs > 0) args.insert(args.end(), {"--jobs", std::to_string(jobs)});
+  std::vector<std::string> args{python_interpreter(), tool.string(), "run"};
+  args.insert(args.end(), study_args.begin(), study_args.end());
+  args.insert(args.end(), {"--fsi", self});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  execv(argv[0], argv.data());
-  fsi::logger("fsi")->error("cannot start {}: {}", argv[0], std::strerror(errno));
+  execvp(argv[0], argv.data());
+  fsi::logger("fsi")->error("cannot start {} (set FSI_PYTHON to a python3 with numpy, yaml, zmq and protobuf): {}",
+                            argv[0], std::strerror(errno));
   return 1;
 }
 
@@ -501,12 +515,11 @@ int main(int argc, char** argv) {
   std::string keys_dir;
   keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")
       ->required();
-  auto* study_cmd = app.add_subcommand("study", "run a parameter study (tools/fsi_study.py run; docs/studies.md)");
-  std::string study_file, study_out = "runs/study";
-  int jobs = 0;
-  study_cmd->add_option("study", study_file, "study file (studies/*.yaml)")->required()->check(CLI::ExistingFile);
-  study_cmd->add_option("--out", study_out, "study folder (results.csv, results.json, runs/)");
-  study_cmd->add_option("--jobs", jobs, "parallel runs (default: number of cores)");
+  auto* study_cmd = app.add_subcommand(
+      "study", "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
+               "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
+  study_cmd->allow_extras();
+  study_cmd->prefix_command();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -516,7 +529,7 @@ int main(int argc, char** argv) {
     fsi::logger("fsi")->error("--resume and --force exclude each other");
     return 1;
   }
-  if (study_cmd->parsed()) return study(study_file, study_out, jobs);
+  if (study_cmd->parsed()) return study(study_cmd->remaining());
   if (keys_cmd->parsed()) {
     if (fs::exists(fs::path(keys_dir) / "server.key_secret") || fs::exists(fs::path(keys_dir) / "coupler.key_secret")) {
       fsi::logger("fsi")->error("{} already holds keys: remove them first or choose another folder", keys_dir);

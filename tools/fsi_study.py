@@ -1394,7 +1394,7 @@ def main(argv=None):
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="run (or resume) a study")
     r.add_argument("study")
-    r.add_argument("--out", required=True)
+    r.add_argument("--out", default="runs/study", help="study folder (default: runs/study)")
     r.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores)")
     r.add_argument("--fsi", default="", help="the fsi executable (default: build/bin/fsi or $FSI_BIN)")
     r.add_argument("--quiet", action="store_true", help="no line per run")
