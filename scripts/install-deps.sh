@@ -8,6 +8,8 @@ packages=(
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libgtest-dev
   gmsh
   python3 python3-zmq python3-protobuf python3-yaml python3-matplotlib python3-psutil
+  python3-numpy python3-scipy python3-pandas python3-distributed python3-nbformat
+  python3-venv python3-setuptools python3-wheel
 )
 missing=()
 for p in "${packages[@]}"; do
