@@ -20,65 +20,22 @@ mean in their CFD/FSI tables).
 import argparse
 import csv
 import json
-import math
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+from fsi import stats as fstats  # noqa: E402
 
 # (midrange mean, amplitude, frequency of the lift) per column
 REFERENCES = {
     "cfd3": {"drag": (439.45, 5.6183, 4.3956), "lift": (-11.893, 437.81, 4.3956)},
 }
 
-
-def crossings(t, y, level):
-    out = []
-    for i in range(1, len(y)):
-        if y[i - 1] < level <= y[i]:
-            s = (level - y[i - 1]) / (y[i] - y[i - 1])
-            out.append(t[i - 1] + s * (t[i] - t[i - 1]))
-    return out
-
-
-def stats(t, y):
-    mean = sum(y) / len(y)
-    up = crossings(t, y, mean)
-    if len(up) < 3:
-        return {"mean": mean, "max": max(y), "min": min(y), "midrange": (max(y) + min(y)) / 2,
-                "amplitude": (max(y) - min(y)) / 2,
-                "frequency": float("nan"), "periods": max(0, len(up) - 1)}
-    # restrict to whole periods
-    sel = [(ti, yi) for ti, yi in zip(t, y) if up[0] <= ti <= up[-1]]
-    ys = [p[1] for p in sel]
-    mean = sum(ys) / len(ys)
-    freq = (len(up) - 1) / (up[-1] - up[0])
-    return {"mean": mean, "max": max(ys), "min": min(ys), "midrange": (max(ys) + min(ys)) / 2,
-            "amplitude": (max(ys) - min(ys)) / 2, "frequency": freq, "periods": len(up) - 1}
-
-
-def harmonic_amplitudes(t, y, f, n):
-    """Amplitudes of y at f, 2f, ..., nf: least squares of a0 + sum (a_k cos + b_k sin)(2 pi k f t)."""
-    import numpy as np
-    t, y = np.asarray(t), np.asarray(y)
-    cols = [np.ones_like(t)]
-    for k in range(1, n + 1):
-        cols += [np.cos(2 * math.pi * k * f * t), np.sin(2 * math.pi * k * f * t)]
-    c, *_ = np.linalg.lstsq(np.column_stack(cols), y, rcond=None)
-    return [float(math.hypot(c[2 * k - 1], c[2 * k])) for k in range(1, n + 1)]
-
-
-def by_period(t, cols, key):
-    """Per period of cols[key] (between successive upward crossings of its mean): for every
-    column (midrange, amplitude), and the period's duration."""
-    y = cols[key]
-    up = crossings(t, y, sum(y) / len(y))
-    out = []
-    for a, b in zip(up[:-1], up[1:]):
-        idx = [i for i, ti in enumerate(t) if a <= ti <= b]
-        row = {"t0": a, "t1": b, "frequency": 1.0 / (b - a)}
-        for c, v in cols.items():
-            vs = [v[i] for i in idx]
-            row[c] = {"midrange": (max(vs) + min(vs)) / 2, "amplitude": (max(vs) - min(vs)) / 2}
-        out.append(row)
-    return out
+# The statistics live in fsi.stats (python/fsi/stats.py); these names stay importable from here.
+crossings = fstats.crossings
+stats = fstats.periodic_stats
+harmonic_amplitudes = fstats.harmonic_amplitudes
+by_period = fstats.by_period
 
 
 def main():

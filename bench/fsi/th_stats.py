@@ -16,9 +16,11 @@ Also prints iterations per step and the wall-time split from summary.json.
 import argparse
 import csv
 import json
-import math
 import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+from fsi import stats as fstats  # noqa: E402
 
 REF = {  # (mean, amplitude, frequency); displacement in 1e-3 m
     "fsi1": {"ux": 0.0227, "uy": 0.8209, "drag": 14.295, "lift": 0.7638},
@@ -43,31 +45,15 @@ def read(run):
 
 def up_crossings(t, y, level, hyst):
     """Upward crossings of level, re-armed only after y fell below level - hyst."""
-    out, armed = [], False
-    for i in range(1, len(y)):
-        if y[i - 1] < level - hyst:
-            armed = True
-        if armed and y[i - 1] < level <= y[i]:
-            s = (level - y[i - 1]) / (y[i] - y[i - 1])
-            out.append(t[i - 1] + s * (t[i] - t[i - 1]))
-            armed = False
-    return out
+    return fstats.crossings(t, y, level, hyst)
 
 
 def periodic(t, y):
-    hi, lo = max(y), min(y)
-    level, hyst = 0.5 * (hi + lo), 0.1 * (hi - lo)
-    up = up_crossings(t, y, level, hyst)
-    if len(up) < 2:
-        return {"mean": level, "amplitude": 0.5 * (hi - lo), "frequency": float("nan"), "periods": 0}
-    ys = [yi for ti, yi in zip(t, y) if up[0] <= ti <= up[-1]]
-    hi, lo = max(ys), min(ys)
-    return {"mean": 0.5 * (hi + lo), "amplitude": 0.5 * (hi - lo),
-            "frequency": (len(up) - 1) / (up[-1] - up[0]), "periods": len(up) - 1}
+    """Turek & Hron's mean = (max + min) / 2, amplitude, frequency over the whole periods."""
+    return fstats.turek_hron(t, y, hysteresis=0.1)
 
 
-def err(ours, ref):
-    return 100.0 * (ours - ref) / abs(ref) if ref else float("nan")
+err = fstats.relative_error_percent
 
 
 def main():
