@@ -1,6 +1,7 @@
 """fsi_study: parameter studies over `fsi run`.
 
   fsi_study.py run STUDY.yaml --out DIR [--jobs N] [--fsi PATH]   run (or resume) a sweep
+               [--set K=V ...] [--dry-run] [--executor local|dask] [--scheduler tcp://H:P] [--shared-dir D]
   fsi_study.py plot DIR                                           PNGs from DIR/results.csv
   fsi_study.py analyse DIR                                        recompute tables without running
 
@@ -29,30 +30,105 @@ from .analysis import analyse, print_counts
 from .plots import cmd_plot
 from .runner import Runner
 from .spec import GridSource, Study, build_sources, reference_spec
-from .util import REPO, StudyError, read_json
+from .check import check_overrides
+from .util import REPO, StudyError, clean_value, read_json
+
+
+def apply_sets(study, sets):
+    """`--set key=value` (repeatable): an override of every run, like the study's `fixed`."""
+    out = {}
+    for s in sets or []:
+        if "=" not in s:
+            raise StudyError(f"--set {s}: expected key=value")
+        k, v = (x.strip() for x in s.split("=", 1))
+        if not k:
+            raise StudyError(f"--set {s}: empty key")
+        if k in study.vary or any(k in g for g in study.zip) or k in study.derived:
+            raise StudyError(f"--set {k}: the study varies or derives '{k}'; --set applies to every run")
+        try:
+            val = yaml.safe_load(v) if v != "" else ""
+        except yaml.YAMLError:
+            val = v
+        out[k] = clean_value(val)
+    study.fixed.update(out)
+    return out
+
+
+def first_specs(study):
+    """The specs that carry every override key of the study: the first run (the first of each
+    source) and the reference run."""
+    sources, _ = build_sources(study)
+    specs = []
+    for src in sources:
+        s = src.next()
+        if s is not None:
+            specs.append(s)
+            break
+    ref = reference_spec(study)
+    if ref and not ref.get("shared"):
+        specs.append(ref)
+    return specs
+
+
+def dry_run(study, out, sources, n, check_how):
+    bis = (study.stability or {}).get("bisection")
+    print(f"study '{study.name}' (dry run, nothing is run): {n} {'bisection groups' if bis else 'runs'} of "
+          f"{study.scene}; keys checked ({check_how})")
+    i = 0
+    for src in sources:
+        while True:
+            s = src.next()
+            if s is None:
+                break
+            i += 1
+            print(f"{i:4d}  {out / 'runs' / s['name']}")
+            print("      " + " ".join(f"--set {x}" for x in s["sets"]))
+            if bis:  # only the first value of each bisection is known before running
+                print(f"      (bisection of {study.stability['parameter']}: further values follow the outcomes)")
+                break
+            src.done(s, {"outcome": "completed"})
+    return 0
+
+
+def make_runner(args, study, out, fsi, jobs):
+    if args.executor == "local":
+        if args.scheduler or args.shared_dir:
+            raise StudyError("--scheduler and --shared-dir need --executor dask")
+        return Runner(study, out, fsi, jobs, quiet=args.quiet)
+    from .executors import DaskRunner
+    return DaskRunner(study, out, fsi, jobs, quiet=args.quiet, scheduler=args.scheduler,
+                      shared_dir=args.shared_dir, retries=args.retries)
 
 
 def cmd_run(args):
     study = Study(args.study)
     out = Path(args.out).resolve()
-    out.mkdir(parents=True, exist_ok=True)
-    copy = dict(study.raw)
-    copy["scene"] = str(study.scene)  # the copy works from DIR (plot, analyse)
-    (out / "study.yaml").write_text(f"# copy of {study.path}\n" + yaml.safe_dump(copy, sort_keys=False))
+    cli_sets = apply_sets(study, args.set)
     fsi = args.fsi or os.environ.get("FSI_BIN") or str(REPO / "build" / "bin" / "fsi")
     if not os.access(fsi, os.X_OK):
         raise StudyError(f"fsi executable not found: {fsi} (build it, or pass --fsi)")
+    fsi = os.path.abspath(fsi)
+    check_how = check_overrides(study, first_specs(study), fsi, cli_sets)
     jobs = max(1, args.jobs or os.cpu_count() or 1)
-    runner = Runner(study, out, os.path.abspath(fsi), jobs, quiet=args.quiet)
     sources, n = build_sources(study)
     ref = reference_spec(study)
     if ref and not ref.get("shared"):
         sources.insert(0, GridSource([ref]))
         n += 1
+    if args.dry_run:
+        return dry_run(study, out, sources, n, check_how)
+    out.mkdir(parents=True, exist_ok=True)
+    copy = dict(study.raw)
+    copy["scene"] = str(study.scene)  # the copy works from DIR (plot, analyse)
+    if cli_sets:  # the copy names the runs as they were run (analyse)
+        copy["fixed"] = dict(study.fixed)
+    (out / "study.yaml").write_text(f"# copy of {study.path}\n" + yaml.safe_dump(copy, sort_keys=False))
+    runner = make_runner(args, study, out, fsi, jobs)
     runner.total_hint = n if not (study.stability or {}).get("bisection") else 0
+    where = f"{jobs} at a time" if args.executor == "local" else runner.describe()
     print(f"study '{study.name}': {n} {'groups' if runner.total_hint == 0 else 'runs'} of {study.scene}, "
-          f"{jobs} at a time, time limit {study.time_limit:g} s, results in {out}", file=sys.stderr)
-    t0 = time.monotonic()
+          f"{where}, time limit {study.time_limit:g} s, results in {out}", file=sys.stderr)
+    t0 = runner.t0 = time.monotonic()
     interrupted = False
 
     def on_term(signum, frame):
@@ -60,19 +136,32 @@ def cmd_run(args):
 
     old = signal.signal(signal.SIGTERM, on_term)
     try:
-        runner.execute(sources)
-    except KeyboardInterrupt:
-        interrupted = True
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        print(f"interrupted: stopping {len(runner.running)} running run(s)", file=sys.stderr)
-        runner.kill_all("interrupted")
+        try:
+            runner.execute(sources)
+        except KeyboardInterrupt:
+            interrupted = True
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            print(f"interrupted: stopping {len(runner.running)} running run(s)", file=sys.stderr)
+            runner.kill_all("interrupted")
+        finally:
+            signal.signal(signal.SIGTERM, old)
+        counts, stab = analyse(study, out, runner.ordered_results(), ref)
+        print(f"{runner.started} run(s) started, {runner.resumed} done before, {time.monotonic() - t0:.1f} s",
+              file=sys.stderr)
+        print_counts(counts, stab, out)
+        if hasattr(runner, "report"):
+            runner.report(out)
     finally:
-        signal.signal(signal.SIGTERM, old)
-    counts, stab = analyse(study, out, runner.results, ref)
-    print(f"{runner.started} run(s) started, {runner.resumed} done before, {time.monotonic() - t0:.1f} s",
-          file=sys.stderr)
-    print_counts(counts, stab, out)
-    return 130 if interrupted else 0
+        if hasattr(runner, "close"):
+            runner.close()
+    if interrupted:
+        return 130
+    no_answer = counts["failed"] + counts["crashes"] + counts["timeouts"]
+    if counts["cases"] and no_answer == counts["cases"]:
+        print(f"fsi_study: every case failed ({counts['failed']} failed, {counts['crashes']} crashed, "
+              f"{counts['timeouts']} timed out): see the reason column of {out}/results.csv", file=sys.stderr)
+        return 1
+    return 0
 
 
 def cmd_analyse(args):
@@ -109,6 +198,21 @@ def main(argv=None):
     r.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores)")
     r.add_argument("--fsi", default="", help="the fsi executable (default: build/bin/fsi or $FSI_BIN)")
     r.add_argument("--quiet", action="store_true", help="no line per run")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="an override of every run, like the study's `fixed` (repeatable)")
+    r.add_argument("--dry-run", action="store_true",
+                   help="check the keys, list the runs (folder and overrides) and run nothing")
+    r.add_argument("--executor", choices=("local", "dask"), default="local",
+                   help="local: process trees here (default); dask: one Dask task per run")
+    r.add_argument("--scheduler", default="", metavar="tcp://HOST:PORT",
+                   help="with --executor dask: a running Dask scheduler (default: a LocalCluster of --jobs "
+                        "single-threaded workers on 127.0.0.1)")
+    r.add_argument("--shared-dir", default="", metavar="DIR",
+                   help="with --executor dask: the study folder as the workers see it (they write the run "
+                        "folders there; default: they send them back)")
+    r.add_argument("--retries", type=int, default=2,
+                   help="with --executor dask: submissions of a run again after Dask gave up on it "
+                        "(KilledWorker: its workers died); default 2")
     p = sub.add_parser("plot", help="PNGs from DIR/results.csv")
     p.add_argument("dir")
     a = sub.add_parser("analyse", help="recompute DIR/results.* from the runs on disk, running nothing")

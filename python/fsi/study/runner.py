@@ -31,6 +31,46 @@ def descendants(pid):
     return out
 
 
+def reap(proc, block=False, timeout=None):
+    """The exit code of proc if it ended (None if not), reaping it with wait4 so that
+    proc.cpu_time = user + system time of the process and of every descendant it waited for
+    (the launcher waits for its servers and coupler: the run's whole process tree)."""
+    if proc.returncode is not None:
+        return proc.returncode
+    end = None if timeout is None else time.monotonic() + timeout
+    while True:
+        try:
+            pid, status, ru = os.wait4(proc.pid, 0 if block and end is None else os.WNOHANG)
+        except ChildProcessError:
+            return proc.poll()
+        if pid:
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            proc.cpu_time = ru.ru_utime + ru.ru_stime
+            return proc.returncode
+        if not block or (end is not None and time.monotonic() >= end):
+            return None
+        time.sleep(0.01)
+
+
+def start_run_process(fsi, scene, d, sets, log, parent_death_signal=None):
+    """`fsi run SCENE --out D --force --set ...` in its own session, output to the open file log.
+    parent_death_signal: the signal the launcher gets when the thread that started it dies (a
+    Dask worker killed with SIGKILL: the launcher then stops its servers and coupler)."""
+    cmd = [fsi, "run", str(scene), "--out", str(d), "--force"]
+    for s in sets:
+        cmd += ["--set", s]
+    pre = None
+    if parent_death_signal is not None:
+        def pre():
+            try:
+                import ctypes
+                ctypes.CDLL(None, use_errno=True).prctl(1, int(parent_death_signal), 0, 0, 0)  # PR_SET_PDEATHSIG
+            except (OSError, AttributeError):
+                pass
+    return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                            start_new_session=True, preexec_fn=pre)
+
+
 def kill_tree(proc, grace=3.0):
     """Stops a run's whole process tree: SIGTERM to the launcher's group (it stops its children),
     then SIGKILL to every process and process group of the tree that is left."""
@@ -40,10 +80,10 @@ def kill_tree(proc, grace=3.0):
     except OSError:
         pass
     end = time.monotonic() + grace
-    while proc.poll() is None and time.monotonic() < end:
+    while reap(proc) is None and time.monotonic() < end:
         tree |= set(descendants(proc.pid))
         time.sleep(0.02)
-    tree |= set(descendants(proc.pid)) if proc.poll() is None else set()
+    tree |= set(descendants(proc.pid)) if reap(proc) is None else set()
     for pid in [proc.pid] + sorted(tree):
         for kill in (lambda p: os.killpg(os.getpgid(p), signal.SIGKILL), lambda p: os.kill(p, signal.SIGKILL)):
             try:
@@ -51,10 +91,7 @@ def kill_tree(proc, grace=3.0):
                     kill(pid)
             except OSError:
                 pass
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        pass
+    reap(proc, block=True, timeout=10)
 
 
 REASON_KINDS = [
@@ -73,6 +110,10 @@ def classify(summary, exit_code, marker_state, log_tail=""):
     if marker_state == "interrupted":
         r.update(status=(summary or {}).get("status", ""), outcome="interrupted", reason_kind="study interrupted",
                  reason="stopped by Ctrl-C / SIGTERM of the study; run again to resume")
+        return r
+    if marker_state == "worker lost":
+        r.update(status=(summary or {}).get("status", ""), outcome="failed", reason_kind="worker lost",
+                 reason=log_tail or "the run's Dask worker died on every attempt; run again to retry")
         return r
     if marker_state == "timeout":
         r.update(status=(summary or {}).get("status", ""), outcome="timeout", reason_kind="time limit")
@@ -128,6 +169,9 @@ class Runner:
         self.started = 0
         self.resumed = 0
         self.total_hint = 0
+        self.finished_here = 0  # runs started and finished by this invocation
+        self.order = []  # run names in the order the sources handed them out
+        self.t0 = time.monotonic()
 
     def marker(self, spec):
         return {"name": spec["name"], "scene": str(self.study.scene), "scene_sha256": self.study.scene_sha,
@@ -150,16 +194,23 @@ class Runner:
         summary = read_json(d / "summary.json")
         c = classify(summary, marker.get("exit_code"), marker.get("state"), log_tail(d / "fsi.log"))
         wall = finite(((summary or {}).get("wall_time") or {}).get("total"))
+        if marker.get("state") == "worker lost":
+            c = classify(summary, marker.get("exit_code"), "worker lost", marker.get("cause", ""))
         rec = {"name": spec["name"], "combo": spec["combo"], "params": spec["params"], **c,
                "exit_code": marker.get("exit_code"), "elapsed": finite(marker.get("elapsed")),
+               "cpu_time": finite(marker.get("cpu_time")),
                "wall_time": wall if wall is not None else finite(marker.get("elapsed")),
                "steps": (summary or {}).get("steps"), "coupling_iterations": (summary or {}).get("coupling_iterations")}
         if rec["steps"] and rec["coupling_iterations"] is not None:
             rec["iterations_per_step"] = rec["coupling_iterations"] / rec["steps"]
+        for k in ("worker", "attempts"):  # Dask executor: where it ran, how many tries it took
+            if marker.get(k) is not None:
+                rec[k] = marker[k]
         self.results[spec["name"]] = rec
         return rec
 
-    def start(self, spec):
+    def prepare(self, spec):
+        """The run folder, emptied of a previous attempt's results, with a 'running' marker."""
         d = self.runs_dir / spec["name"]
         d.mkdir(parents=True, exist_ok=True)
         for f in ("summary.json", "probes.csv", "iterations.csv"):
@@ -167,22 +218,28 @@ class Runner:
         m = self.marker(spec)
         m["state"] = "running"
         write_json(d / "study_run.json", m)
-        cmd = [self.fsi, "run", str(self.study.scene), "--out", str(d), "--force"]
-        for s in spec["sets"]:
-            cmd += ["--set", s]
+        return d
+
+    def start(self, spec):
+        d = self.prepare(spec)
         log = open(d / "fsi.log", "w")
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                start_new_session=True)
+        proc = start_run_process(self.fsi, self.study.scene, d, spec["sets"], log)
         self.running[spec["name"]] = (proc, spec, time.monotonic(), log)
         self.started += 1
 
     def finish(self, name, state):
         proc, spec, t0, log = self.running.pop(name)
         log.close()
+        return self.conclude(spec, {"state": state, "exit_code": proc.returncode, "elapsed": time.monotonic() - t0,
+                                    "cpu_time": getattr(proc, "cpu_time", None)})
+
+    def conclude(self, spec, fields):
+        """Writes the run's final marker (its state, exit code, times), records and reports it."""
         m = self.marker(spec)
-        m.update(state=state, exit_code=proc.returncode, elapsed=time.monotonic() - t0)
-        write_json(self.runs_dir / name / "study_run.json", m)
+        m.update(fields)
+        write_json(self.runs_dir / spec["name"] / "study_run.json", m)
         rec = self.record(spec, m)
+        self.finished_here += 1
         self.progress(rec)
         return rec
 
@@ -193,19 +250,60 @@ class Runner:
         extra = f" ({rec['reason_kind']})" if rec["reason_kind"] and rec["outcome"] != "completed" else ""
         wt = "%.2f s" % rec["wall_time"] if rec["wall_time"] is not None else "-"
         print(f"[{n}{'/' + str(self.total_hint) if self.total_hint else ''}] {rec['name']}: "
-              f"{rec['outcome']}{extra}, {wt}{' (done before)' if resumed else ''}", file=sys.stderr, flush=True)
+              f"{rec['outcome']}{extra}, {wt}{' (done before)' if resumed else ''}{self.eta(n)}",
+              file=sys.stderr, flush=True)
+
+    def eta(self, n):
+        """' | 40 %, 12.3 s, ETA 18 s': the study's progress (runs done of the total, the time
+        since it started, the time left at the rate of this invocation's finished runs)."""
+        el = time.monotonic() - self.t0
+        if not self.total_hint:
+            return f" | {el:.1f} s"
+        left = max(self.total_hint - n, 0)
+        s = f" | {100.0 * min(n, self.total_hint) / self.total_hint:.0f} %, {el:.1f} s"
+        if left == 0:
+            return s
+        if self.finished_here == 0:
+            return s + ", ETA -"
+        return s + f", ETA {el / self.finished_here * left:.0f} s"
 
     def kill_all(self, state):
         for name in list(self.running):
             kill_tree(self.running[name][0])
             self.finish(name, state)
 
+    def ordered_results(self):
+        """The records in the order the runs were handed out (not the order they finished in): the
+        column order of results.csv does not depend on which run finished first."""
+        out = {n: self.results[n] for n in self.order if n in self.results}
+        out.update({n: r for n, r in self.results.items() if n not in out})
+        return out
+
+    def capacity(self):
+        return self.jobs
+
+    def poll_running(self):
+        """Concludes the runs that ended or passed the time limit; True if any did."""
+        progressed = False
+        for name in list(self.running):
+            proc, spec, t0, _ = self.running[name]
+            if reap(proc) is not None:
+                spec["_source"].done(spec, self.finish(name, "finished"))
+                progressed = True
+            elif time.monotonic() - t0 > self.study.time_limit:
+                kill_tree(proc)
+                spec["_source"].done(spec, self.finish(name, "timeout"))
+                progressed = True
+        return progressed
+
+    def idle(self):
+        time.sleep(0.01)
+
     def execute(self, sources):
-        """Runs every spec the sources hand out, at most `jobs` at a time."""
-        limit = self.study.time_limit
+        """Runs every spec the sources hand out, at most `capacity()` at a time."""
         while True:
             progressed = False
-            while len(self.running) < self.jobs:
+            while len(self.running) < self.capacity():
                 spec = None
                 for src in sources:
                     spec = src.next()
@@ -214,6 +312,8 @@ class Runner:
                 if spec is None:
                     break
                 progressed = True
+                if spec["name"] not in self.order:
+                    self.order.append(spec["name"])
                 if spec["name"] in self.results:
                     src.done(spec, self.results[spec["name"]])
                     continue
@@ -224,19 +324,11 @@ class Runner:
                     self.progress(rec, resumed=True)
                     src.done(spec, rec)
                     continue
-                self.start(spec)
                 spec["_source"] = src
-            for name in list(self.running):
-                proc, spec, t0, _ = self.running[name]
-                if proc.poll() is not None:
-                    spec["_source"].done(spec, self.finish(name, "finished"))
-                    progressed = True
-                elif time.monotonic() - t0 > limit:
-                    kill_tree(proc)
-                    spec["_source"].done(spec, self.finish(name, "timeout"))
-                    progressed = True
+                self.start(spec)
+            if self.poll_running():
+                progressed = True
             if not self.running and all(s.finished() for s in sources):
                 return
             if not progressed:
-                time.sleep(0.01)
-
+                self.idle()
