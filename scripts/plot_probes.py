@@ -5,9 +5,16 @@
 """
 import argparse
 import csv
+import difflib
 import os
+import sys
 
-import matplotlib
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+import fsi.interpreter  # noqa: E402
+
+fsi.interpreter.require("numpy", "matplotlib")  # under another python3: re-run with FSI_PYTHON
+
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -22,12 +29,28 @@ def main():
     p.add_argument("--ylabel", default=None)
     p.add_argument("--hline", type=float, default=None, help="reference value to draw")
     a = p.parse_args()
-    fig, ax = plt.subplots(figsize=(7, 4.2))
+    series = []
     for item in a.runs:
         folder, _, label = item.partition(":")
-        with open(os.path.join(folder, "probes.csv")) as f:
-            rows = list(csv.DictReader(f))
-        ax.plot([float(r["time"]) for r in rows], [float(r[a.probe]) for r in rows], label=label or folder)
+        path = os.path.join(folder, "probes.csv")
+        try:
+            with open(path) as f:
+                reader = csv.DictReader(f)
+                rows = list(reader)
+                columns = reader.fieldnames or []
+        except OSError as e:
+            print(f"plot_probes.py: {path}: {e.strerror}", file=sys.stderr)
+            return 1
+        if a.probe not in columns:
+            near = difflib.get_close_matches(a.probe, columns, n=1)
+            print(f"plot_probes.py: {path} has no probe '{a.probe}'"
+                  + (f" (did you mean '{near[0]}'?)" if near else "")
+                  + f"; columns: {', '.join(c for c in columns if c != 'time')}", file=sys.stderr)
+            return 1
+        series.append(([float(r["time"]) for r in rows], [float(r[a.probe]) for r in rows], label or folder))
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for t, y, label in series:
+        ax.plot(t, y, label=label)
     if a.hline is not None:
         ax.axhline(a.hline, color="k", lw=0.8, ls="--", label=f"{a.hline:g}")
     ax.set_xlabel("time")
@@ -39,7 +62,8 @@ def main():
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     fig.savefig(a.out, dpi=110)
     print(f"wrote {a.out}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

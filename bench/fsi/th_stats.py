@@ -20,6 +20,9 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "python"))
+import fsi.interpreter  # noqa: E402
+
+fsi.interpreter.require("numpy")  # under another python3: re-run with FSI_PYTHON
 from fsi import stats as fstats  # noqa: E402
 
 REF = {  # (mean, amplitude, frequency); displacement in 1e-3 m

@@ -66,10 +66,14 @@ import sys
 import time as _time
 import traceback
 
-import numpy as np
-import yaml
+from fsi.interpreter import require as _require
 
-from fsi.v1 import coupling_pb2 as pb
+_require("numpy", "yaml", "zmq", "google.protobuf")  # a script under another python3: re-run with FSI_PYTHON
+
+import numpy as np  # noqa: E402
+import yaml  # noqa: E402
+
+from fsi.v1 import coupling_pb2 as pb  # noqa: E402
 
 VERSION = 1
 CONFIGURE_ARGS = ("dt", "end_time", "interface_damping", "output_dir")
