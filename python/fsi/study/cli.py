@@ -156,10 +156,12 @@ def cmd_run(args):
             runner.close()
     if interrupted:
         return 130
-    no_answer = counts["failed"] + counts["crashes"] + counts["timeouts"]
-    if counts["cases"] and no_answer == counts["cases"]:
-        print(f"fsi_study: every case failed ({counts['failed']} failed, {counts['crashes']} crashed, "
-              f"{counts['timeouts']} timed out): see the reason column of {out}/results.csv", file=sys.stderr)
+    # Every case failed: none could run (a configuration error, a dead peer, a crash, a lost
+    # worker). Divergence and time limits are answers of a study, not failures of it.
+    no_run = counts["failed"] + counts["crashes"]
+    if counts["cases"] and no_run == counts["cases"]:
+        print(f"fsi_study: every case failed ({counts['failed']} failed, {counts['crashes']} crashed): "
+              f"see the reason column of {out}/results.csv", file=sys.stderr)
         return 1
     return 0
 
