@@ -3,6 +3,7 @@
 - ``fsi.server``: write an external solid in a few lines (the protocol, errors, sessions,
   checkpoints and the launcher's command line are handled for you).
 - ``fsi.run(scene, out, set={...})`` runs ``fsi run``; ``fsi.load(out)`` reads a run folder.
+- ``fsi.load_study(folder)``: one table (pandas, else numpy arrays) of a study folder (``fsi.study``).
 - ``fsi.stats``: mean, amplitude, frequency, phase lag, settling time, Turek-Hron midrange.
 - ``fsi.v1.coupling_pb2``: the generated protocol module.
 
@@ -13,9 +14,10 @@ import importlib
 __version__ = "0.1.0"
 PROTOCOL_VERSION = 1
 
-__all__ = ["run", "load", "RunError", "Run", "server", "stats", "results", "v1", "__version__", "PROTOCOL_VERSION"]
+__all__ = ["run", "load", "RunError", "Run", "load_study", "server", "stats", "results", "v1", "__version__", "PROTOCOL_VERSION"]
 
-_LAZY = {"run": "results", "load": "results", "RunError": "results", "Run": "results"}
+_LAZY = {"run": "results", "load": "results", "RunError": "results", "Run": "results",
+         "load_study": "study"}
 
 
 def __getattr__(name):
