@@ -172,7 +172,10 @@ def cmd_analyse(args):
     runner = Runner(study, out, "", 1, quiet=True)
     sources, _ = build_sources(study)
     ref = reference_spec(study)
-    specs = ([ref] if ref and not ref.get("shared") else [])
+    for s in ([ref] if ref and not ref.get("shared") else []):  # first, as `run` hands it out first
+        m = read_json(out / "runs" / s["name"] / "study_run.json")
+        if m:
+            runner.record(s, m)
     for src in sources:  # grids: every spec; bisection: replay from the markers
         while not src.finished():
             s = src.next()
@@ -182,10 +185,6 @@ def cmd_analyse(args):
             if not m:
                 break
             src.done(s, runner.record(s, m))
-    for s in specs:
-        m = read_json(out / "runs" / s["name"] / "study_run.json")
-        if m:
-            runner.record(s, m)
     counts, stab = analyse(study, out, runner.results, ref)
     print_counts(counts, stab, out)
     return 0
