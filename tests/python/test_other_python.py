@@ -86,6 +86,31 @@ msg = p.stderr.strip().splitlines()[-1] if p.stderr.strip() else ""
 check(p.returncode == 1 and "Traceback" not in p.stderr and "no probe 'solid.dx'" in msg and "did you mean 'solid.d_x'" in msg
       and "solid.v_x" in msg and not (work / "x.png").exists(), f"misspelt probe: exit {p.returncode}, {msg!r}")
 
+# proto/README.md's minimal external solid (a point mass on fsi.server), run as documented
+# (PYTHONPATH=python, python3 first on PATH being the bare one): the C++ sdof solid with
+# stiffness 0 and damping 0 is the same point mass, so the histories agree.
+text = (SRC / "proto" / "README.md").read_text()
+block = text[text.index("## A minimal external solid (Python)"):]
+block = block[block.index("```python\n") + 10:]
+block = block[:block.index("```")]
+check(len(block.strip().splitlines()) <= 25, f"the minimal solid is {len(block.strip().splitlines())} lines (<= 25)")
+(work / "my_solid.py").write_text(block)
+pm = ["--set", "solid.stiffness=0", "--set", "solid.damping=0", "--set", "coupling.gamma_n1=10"]
+e3 = dict(env, PYTHONPATH=str(SRC / "python"))
+p = run([FSI, "run", "configs/sdof_model.yaml", "--out", str(work / "pm_py"), *pm, "--solid-command",
+         f"python3 {work / 'my_solid.py'}"], SRC, e3)
+check(p.returncode == 0, f"the minimal solid runs: exit {p.returncode} {(p.stdout + p.stderr)[-400:] if p.returncode else ''}")
+p = run([FSI, "run", "configs/sdof_model.yaml", "--out", str(work / "pm_cpp"), *pm], SRC)
+if (work / "pm_py" / "probes.csv").exists() and (work / "pm_cpp" / "probes.csv").exists():
+    import csv
+    a_, b_ = (list(csv.DictReader(open(work / n / "probes.csv"))) for n in ("pm_py", "pm_cpp"))
+    # different but equivalent formulas (v first, then d; the C++ solves for d): round-off only
+    err = max(abs(float(x["solid.d_x"]) - float(y["solid.d_x"])) for x, y in zip(a_, b_))
+    scale = max(abs(float(y["solid.d_x"])) for y in b_)
+    check(len(a_) == len(b_) == 500 and err <= 2e-12 * scale,
+          f"minimal solid = C++ sdof with k = c = 0: max |d_x difference| {err:.1e} = {err / scale:.1e} of max |d_x| "
+          f"{scale:.3g} (<= 2e-12 relative) over {len(a_)} steps")
+
 # The statistics CLIs too.
 p = run(["python3", str(SRC / "bench" / "fluid" / "periodic_stats.py"), str(work / "py" / "probes.csv"),
          "--columns", "solid.d_x", "--window", "10"], work)
