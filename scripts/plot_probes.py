@@ -19,6 +19,8 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from fsi.plots import sort_legend, wrap_title  # noqa: E402
+
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -55,9 +57,9 @@ def main():
         ax.axhline(a.hline, color="k", lw=0.8, ls="--", label=f"{a.hline:g}")
     ax.set_xlabel("time")
     ax.set_ylabel(a.ylabel or a.probe)
-    ax.set_title(a.title)
+    wrap_title(ax, a.title)
     ax.grid(alpha=0.3)
-    ax.legend()
+    sort_legend(ax)  # runs/g0 runs/g1 runs/g10 runs/g100 in numeric order, however given
     fig.tight_layout()
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     fig.savefig(a.out, dpi=110)
