@@ -71,3 +71,25 @@ check(p.returncode == 1 and c["crashes"] == 6 and "every case failed" in p.stder
       f"every case failed: exit {p.returncode}, {c['crashes']} crashed")
 p = run_tool("run", str(study), "--out", str(w / "out"), "--fsi", FSI, "--set", "solid.force=0.5")
 check(p.returncode == 0, "a study with completed cases exits 0")
+
+# An fsi with the `check` subcommand decides: its refusal (exit 1, stderr) stops the study.
+wrap = w / "fsi_with_check"
+wrap.write_text(f"""#!/bin/sh
+if [ "$1" = check ]; then
+  echo "$@" >> {w}/check_calls
+  if [ "$2" = --help ]; then echo "Usage: fsi check [OPTIONS] SCENE"; exit 0; fi
+  case "$*" in *relaxation=0.5*) echo "{SRC}/configs/sdof_model.yaml: 'coupling.relaxation' is out of range" >&2; exit 1;; esac
+  exit 0
+fi
+exec {FSI} "$@"
+""")
+wrap.chmod(0o755)
+p = run_tool("run", str(study), "--out", str(w / "chk"), "--fsi", str(wrap), "--set", "coupling.relaxation=0.5",
+             check=False)
+calls = (w / "check_calls").read_text().splitlines()
+check(p.returncode == 1 and "out of range" in p.stderr and not (w / "chk").exists(),
+      "fsi check's refusal stops the study before anything runs, with its message")
+check(len(calls) == 2 and calls[1].startswith(f"check {SRC}/configs/sdof_model.yaml --set coupling.algorithm=1"),
+      f"fsi check SCENE --set ... called with the first run's overrides ({calls[1][:60]}...)")
+p = run_tool("run", str(study), "--out", str(w / "chk"), "--fsi", str(wrap), "--dry-run")
+check(p.returncode == 0 and "keys checked (fsi check)" in p.stdout, "accepted by fsi check: the dry run says so")
