@@ -272,12 +272,16 @@ def by_period(t, cols, key):
 # Transients
 # ----------------------------------------------------------------------------------------------
 
-def settling_time(t, y, final=None, band=0.02, relative=True, interpolate=True):
+def settling_time(t, y, final=None, band=0.02, relative=True, how="interpolate"):
     """The time after which y stays within the band around final: |y - final| <= band * |final|
     (relative, the "2 % settling time") or <= band (relative=False). final defaults to the last
     sample. Returns t[0] when y never leaves the band, None when the last sample is outside it.
-    interpolate: the time where the straight line between the last sample outside the band and
-    the next one enters the band (else: the time of the first sample inside for good)."""
+    how: "interpolate" (default): where the straight line between the last sample outside the
+    band and the next one enters the band; "last_outside": the time of the last sample outside
+    (the convention of the README's and docs/paper_examples.md's settling times);
+    "first_inside": the time of the first sample inside for good."""
+    if how not in ("interpolate", "last_outside", "first_inside"):
+        raise StatsError(f"settling_time: how must be interpolate, last_outside or first_inside, not {how!r}")
     t, y = _arrays(t, y)
     if len(t) == 0:
         return None
@@ -290,7 +294,9 @@ def settling_time(t, y, final=None, band=0.02, relative=True, interpolate=True):
     i = int(out[-1])
     if i == len(t) - 1:
         return None
-    if not interpolate:
+    if how == "last_outside":
+        return float(t[i])
+    if how == "first_inside":
         return float(t[i + 1])
     # the line y(t) between samples i and i+1 meets final +- tol
     edge = final + tol if y[i] > final else final - tol

@@ -115,8 +115,11 @@ ys = Fk * (1 - np.exp(-ts / tau))
 st = S.settling_time(ts, ys, final=Fk, band=0.02)
 # linear interpolation of a convex curve over dt = 2e-3: error < dt^2 / (8 tau) relative... bound by dt
 close(st, tau * math.log(50), 1e-5, "settling time (2 %) of an exponential = tau ln 50")
-close(S.settling_time(ts, ys, final=Fk, band=0.02, interpolate=False), tau * math.log(50), 2e-3,
-      "settling time, first sample inside for good")
+ts50 = tau * math.log(50)
+fi = S.settling_time(ts, ys, final=Fk, band=0.02, how="first_inside")
+lo = S.settling_time(ts, ys, final=Fk, band=0.02, how="last_outside")
+check(lo < ts50 <= fi and abs(fi - lo - 2e-3) < 1e-12 and abs(fi - ts50) < 2e-3,
+      f"settling time, last sample outside {lo} < tau ln 50 = {ts50:.6f} <= first sample inside {fi}, one step apart")
 close(S.settling_time(ts, ys, final=Fk, band=0.001 * Fk, relative=False), tau * math.log(1000), 1e-5,
       "settling time, absolute band = tau ln 1000")
 # damped oscillation: last exit of the band
