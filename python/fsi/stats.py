@@ -61,6 +61,12 @@ def finite(x):
     return x if math.isfinite(x) else None
 
 
+def _mean(y):
+    """Arithmetic mean summed left to right (as the benchmark scripts always did, so their
+    results stay identical to the last bit)."""
+    return float(sum(np.asarray(y, float).tolist()) / len(y))
+
+
 def _arrays(t, y):
     return np.asarray(t, float), np.asarray(y, float)
 
@@ -221,7 +227,7 @@ def periodic_stats(t, y, level=None, hysteresis=0.0, min_crossings=3):
     midrange, amplitude ((max - min) / 2), frequency (periods / their duration), periods.
     With fewer than min_crossings crossings: the same over all samples, frequency NaN."""
     t, y = _arrays(t, y)
-    mean = float(np.mean(y))
+    mean = _mean(y)
     up = crossings(t, y, mean if level is None else level, hysteresis)
     if len(up) < min_crossings:
         hi, lo = float(np.max(y)), float(np.min(y))
@@ -229,7 +235,7 @@ def periodic_stats(t, y, level=None, hysteresis=0.0, min_crossings=3):
                 "frequency": float("nan"), "periods": max(0, len(up) - 1)}
     ys = y[(t >= up[0]) & (t <= up[-1])]
     hi, lo = float(np.max(ys)), float(np.min(ys))
-    return {"mean": float(np.mean(ys)), "max": hi, "min": lo, "midrange": (hi + lo) / 2,
+    return {"mean": _mean(ys), "max": hi, "min": lo, "midrange": (hi + lo) / 2,
             "amplitude": (hi - lo) / 2, "frequency": (len(up) - 1) / (up[-1] - up[0]), "periods": len(up) - 1}
 
 
@@ -256,7 +262,7 @@ def by_period(t, cols, key):
     t0, t1, frequency = 1 / (t1 - t0), and for every column {midrange, amplitude}."""
     t = np.asarray(t, float)
     cols = {c: np.asarray(v, float) for c, v in cols.items()}
-    up = crossings(t, cols[key], float(np.mean(cols[key])))
+    up = crossings(t, cols[key], _mean(cols[key]))
     out = []
     for a, b in zip(up[:-1], up[1:]):
         sel = (t >= a) & (t <= b)
