@@ -196,7 +196,7 @@ def main(argv=None):
     r = sub.add_parser("run", help="run (or resume) a study")
     r.add_argument("study")
     r.add_argument("--out", default="runs/study", help="study folder (default: runs/study)")
-    r.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores)")
+    r.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores); with --executor dask and no --scheduler: the LocalCluster's workers")
     r.add_argument("--fsi", default="", help="the fsi executable (default: build/bin/fsi or $FSI_BIN)")
     r.add_argument("--quiet", action="store_true", help="no line per run")
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
