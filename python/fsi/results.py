@@ -4,6 +4,7 @@
     r = fsi.run("configs/sdof_model.yaml", "runs/g10", set={"coupling.gamma_n1": 10}, force=True)
     d = fsi.load("runs/g10")                 # or r.load()
     d.summary["status"], d.probes["time"], d.probes["solid.d_x"], d.iterations["residual"]
+    cols = d.to_dict()                       # {column: array}; d.to_dict("iterations")
     df = fsi.load("runs/g10", pandas=True).probes   # a pandas DataFrame
 
 ``fsi.run`` starts ``fsi run`` as a subprocess and waits for it. The executable is the
@@ -123,6 +124,15 @@ class Results:
         if self.probes is None:
             return []
         return list(self.probes.columns) if hasattr(self.probes, "columns") else list(self.probes.dtype.names)
+
+    def to_dict(self, table="probes"):
+        """{column: numpy array} of probes.csv (table="probes") or iterations.csv ("iterations")."""
+        data = getattr(self, table)
+        if data is None:
+            return {}
+        if hasattr(data, "columns"):
+            return {c: data[c].to_numpy() for c in data.columns}
+        return {c: np.array(data[c]) for c in data.dtype.names}
 
     def __getitem__(self, probe):
         """The probe's column; an unknown name raises KeyError listing the available ones."""

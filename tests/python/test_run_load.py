@@ -56,7 +56,10 @@ ih, irows = irows[0], irows[1:]
 same = all(np.array_equal(d.iterations[c], np.array([float(x[i]) for x in irows])) for i, c in enumerate(ih))
 check(same and d.iterations["step"].dtype == np.int64 and len(d.iterations) == len(irows),
       f"iterations.csv: {len(irows)} rows equal, integer columns int64 ({d.iterations.dtype})")
-# the physics: d -> F/k = 0.1282 (docs), and r.probes is the same as fsi.load
+dd = d.to_dict()
+check(list(dd) == header and all(np.array_equal(dd[c], d.probes[c]) for c in header)
+      and set(d.to_dict("iterations")) == set(ih), "to_dict(): {column: array} of both tables")
+# Run.probes reads the same folder
 check(np.array_equal(r.probes["solid.d_x"], d["solid.d_x"]), "Run.probes = fsi.load(out).probes")
 try:
     import pandas  # noqa: F401
