@@ -158,6 +158,8 @@ void read_elements_v2(LineReader& reader, ReaderState& state) {
   for (long i = 0; i < count[0]; ++i) {
     const auto v = parse_numbers<long>(reader, reader.require("an element"), 3, "'id type ntags ...'");
     const int type = static_cast<int>(v[1]);
+    if (v[2] < 0 || v[2] > static_cast<long>(v.size()))
+      reader.fail(fmt::format("element {} has {} tags: must be between 0 and the numbers on its line", v[0], v[2]));
     const int ntags = static_cast<int>(v[2]);
     const int nn = nodes_per_element(type);
     if (dimension_of(type) > 2) continue;
