@@ -18,6 +18,7 @@ import sys
 __all__ = ["require", "candidates", "missing"]
 
 _GUARD = "FSI_PYTHON_REEXEC"
+_REEXECUTED = False
 _SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
@@ -65,8 +66,11 @@ def require(*modules, script=None):
     """Make sure this interpreter can import every module; else re-run the script (default:
     sys.argv[0]) with the first candidate interpreter that is not this one. Returns only when
     the modules are importable (or no other interpreter can be tried)."""
+    global _REEXECUTED
+    if os.environ.pop(_GUARD, None):  # this process is the re-run: never again, but its children may
+        _REEXECUTED = True
     absent = missing(modules)
-    if not absent or os.environ.get(_GUARD):
+    if not absent or _REEXECUTED:
         return
     if script is None:
         main = sys.modules.get("__main__")
