@@ -89,7 +89,7 @@ p = run_tool("run", str(study), "--out", str(w / "chk"), "--fsi", str(wrap), "--
 calls = (w / "check_calls").read_text().splitlines()
 check(p.returncode == 1 and "out of range" in p.stderr and not (w / "chk").exists(),
       "fsi check's refusal stops the study before anything runs, with its message")
-check(len(calls) == 2 and calls[1].startswith(f"check {SRC}/configs/sdof_model.yaml --set coupling.algorithm=1"),
+check(len(calls) == 2 and calls[1].startswith(f"check {SRC.resolve()}/configs/sdof_model.yaml --set coupling.algorithm=1"),
       f"fsi check SCENE --set ... called with the first run's overrides ({calls[1][:60]}...)")
 p = run_tool("run", str(study), "--out", str(w / "chk"), "--fsi", str(wrap), "--dry-run")
 check(p.returncode == 0 and "keys checked (fsi check)" in p.stdout, "accepted by fsi check: the dry run says so")

@@ -308,6 +308,7 @@ class DaskRunner(Runner):
 
     def summary(self):
         import statistics
+        self._check_workers(force=True)
         retried = {n: a for n, a in self.attempts.items() if a > 1}
         s = {"executor": "dask", "scheduler": self.where, "study_id": self.study_id,
              "workers_seen": sorted(self.workers_seen), "workers_lost": sorted(self.workers_lost),
