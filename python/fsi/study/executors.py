@@ -148,7 +148,10 @@ class DaskRunner(Runner):
         pkg = str(Path(__file__).resolve().parents[2])
         os.environ["PYTHONPATH"] = pkg + (os.pathsep + os.environ["PYTHONPATH"] if os.environ.get("PYTHONPATH") else "")
         if scheduler:
-            self.client = distributed.Client(scheduler, timeout=30)
+            try:
+                self.client = distributed.Client(scheduler, timeout=15)
+            except (OSError, TimeoutError) as e:
+                raise StudyError(f"cannot reach the Dask scheduler {scheduler}: {e}") from None
             self.where = scheduler
         else:
             with dask.config.set({"distributed.scheduler.allowed-failures": 2,
@@ -251,6 +254,8 @@ class DaskRunner(Runner):
             fut.release()
             if res is None:
                 cause = f"{type(err).__name__}: {err}"
+                if isinstance(err, ImportError):
+                    cause += " (the workers must import fsi.study: PYTHONPATH=<repo>/python, pip install ./python, or the image)"
                 if self._resubmitted.get(name, 0) < self.retries:
                     self._resubmitted[name] = self._resubmitted.get(name, 0) + 1
                     self.resubmitted += 1
@@ -260,9 +265,10 @@ class DaskRunner(Runner):
                     self._submit(spec)
                     continue
                 self.running.pop(name)
+                lost_worker = type(err).__name__ in ("KilledWorker", "CommClosedError")
                 spec["_source"].done(spec, self.conclude(spec, {
-                    "state": "worker lost", "exit_code": None, "elapsed": None, "attempts": self.attempts[name],
-                    "cause": f"{cause} (after {self.attempts[name]} attempt(s))"}))
+                    "state": "worker lost" if lost_worker else "executor error", "exit_code": None, "elapsed": None,
+                    "attempts": self.attempts[name], "cause": f"{cause} (after {self.attempts[name]} attempt(s))"}))
                 continue
             d = self.runs_dir / name
             if res["tar"] is not None:  # the run folder as the worker wrote it (conclude writes the marker)

@@ -111,9 +111,9 @@ def classify(summary, exit_code, marker_state, log_tail=""):
         r.update(status=(summary or {}).get("status", ""), outcome="interrupted", reason_kind="study interrupted",
                  reason="stopped by Ctrl-C / SIGTERM of the study; run again to resume")
         return r
-    if marker_state == "worker lost":
-        r.update(status=(summary or {}).get("status", ""), outcome="failed", reason_kind="worker lost",
-                 reason=log_tail or "the run's Dask worker died on every attempt; run again to retry")
+    if marker_state in ("worker lost", "executor error"):  # Dask: the task, not the run, failed
+        r.update(status=(summary or {}).get("status", ""), outcome="failed", reason_kind=marker_state,
+                 reason=log_tail or "the run's Dask task failed on every attempt; run again to retry")
         return r
     if marker_state == "timeout":
         r.update(status=(summary or {}).get("status", ""), outcome="timeout", reason_kind="time limit")
@@ -194,8 +194,8 @@ class Runner:
         summary = read_json(d / "summary.json")
         c = classify(summary, marker.get("exit_code"), marker.get("state"), log_tail(d / "fsi.log"))
         wall = finite(((summary or {}).get("wall_time") or {}).get("total"))
-        if marker.get("state") == "worker lost":
-            c = classify(summary, marker.get("exit_code"), "worker lost", marker.get("cause", ""))
+        if marker.get("state") in ("worker lost", "executor error"):
+            c = classify(summary, marker.get("exit_code"), marker["state"], marker.get("cause", ""))
         rec = {"name": spec["name"], "combo": spec["combo"], "params": spec["params"], **c,
                "exit_code": marker.get("exit_code"), "elapsed": finite(marker.get("elapsed")),
                "cpu_time": finite(marker.get("cpu_time")),
