@@ -12,7 +12,8 @@ Reported per worker count:
   elapsed time: temporary folder, tar of the run folder) from DIR/executor.json, and for the
   whole pipeline (W x wall - sum of run elapsed) / runs: scheduling, result transfer, the
   client's unpacking and bookkeeping, and idle workers at the end;
-- the load average (uptime) before and after: this machine has 2 cores and runs other jobs.
+- the load average (uptime) before and after: this machine has 2 cores and runs other jobs;
+- for comparison, the local executor with --jobs 1 and 2 on the same study.
 
   /usr/bin/python3 bench/studies/dask_scaling.py [--out DIR] [--fsi build/bin/fsi] [--workers 1 2]
 """
@@ -110,16 +111,28 @@ reference:
                     except subprocess.TimeoutExpired:
                         os.killpg(p.pid, signal.SIGKILL)
                         p.wait()
+    local = []
+    for jobs in args.workers:  # the local executor on the same study, for comparison
+        d = out / f"local{jobs}"
+        p = subprocess.run(["/usr/bin/python3", str(SRC / "tools" / "fsi_study.py"), "run", str(study), "--out", str(d),
+                            "--fsi", args.fsi, "--jobs", str(jobs), "--quiet"], capture_output=True, text=True,
+                           timeout=600, env=env)
+        wall = float(re.search(r"run\(s\) started, \d+ done before, ([\d.]+) s", p.stderr).group(1))
+        elapsed = [json.loads((r / "study_run.json").read_text())["elapsed"] for r in (d / "runs").iterdir()]
+        local.append({"jobs": jobs, "wall_s": wall, "sum_run_elapsed_s": sum(elapsed), "load_after": uptime()})
     base = rows[0]["wall_s"]
     for r in rows:
         r["speedup"] = base / r["wall_s"]
-    (out / "dask_scaling.json").write_text(json.dumps(rows, indent=1) + "\n")
+    (out / "dask_scaling.json").write_text(json.dumps({"dask": rows, "local": local}, indent=1) + "\n")
     print(f"{'workers':>7} {'runs':>4} {'wall [s]':>8} {'command [s]':>11} {'speed-up':>8} {'sum runs [s]':>12} "
           f"{'mean run [s]':>12} {'in-task ovh [ms]':>16} {'pipeline ovh/task [ms]':>22}")
     for r in rows:
         print(f"{r['workers']:>7} {r['runs']:>4} {r['wall_s']:>8.2f} {r['command_s']:>11.2f} {r['speedup']:>8.2f} "
               f"{r['sum_run_elapsed_s']:>12.2f} {r['mean_run_elapsed_s']:>12.3f} {r['in_task_overhead_ms']:>16.1f} "
               f"{r['pipeline_overhead_per_task_ms']:>22.1f}")
+    for r in local:
+        print(f"local executor --jobs {r['jobs']}: wall {r['wall_s']:.2f} s, sum of runs {r['sum_run_elapsed_s']:.2f} s, "
+              f"speed-up {local[0]['wall_s'] / r['wall_s']:.2f}; load after: {r['load_after']}")
     for r in rows:
         print(f"load ({r['workers']} worker(s)): before: {r['load_before']} | after: {r['load_after']}")
     print(f"table: {out / 'dask_scaling.json'}")
