@@ -127,6 +127,23 @@ try:
     check(len(tab) == 12 and (tab["cpu_time"] > 0).all() and (tab["cpu_time"] < 60).all(),
           f"load_study: 12 rows, CPU time per run {tab['cpu_time'].min():.3f}..{tab['cpu_time'].max():.3f} s")
 
+    # A run past its time limit: its whole process tree is killed on the worker: 'timeout'.
+    slow = w / "slow.yaml"
+    slow.write_text(f"""
+study: slow
+scene: {SRC}/configs/sdof_model.yaml
+fixed: {{time.end: 100000.0, time.dt: 0.001}}
+vary: {{coupling.gamma_n1: [1, 2]}}
+time_limit: 1.5
+""")
+    t0 = time.monotonic()
+    run_tool("run", str(slow), "--out", str(w / "slow"), "--fsi", FSI, "--executor", "dask", "--scheduler", addr,
+             timeout=60)
+    c = outcomes(w / "slow")
+    check(c["timeouts"] == 2 and c["crashes"] == 0 and time.monotonic() - t0 < 20,
+          f"time limit on the workers: 2 timeouts in {time.monotonic() - t0:.1f} s")
+    check(not leftovers(str(w / "slow")), "no process of the timed-out runs is left")
+
     # 2. A worker killed (SIGKILL) while it runs a case.
     out = w / "killed"
     client = subprocess.Popen(["/usr/bin/python3", str(TOOL), "run", str(study), "--out", str(out), "--fsi", FSI,
