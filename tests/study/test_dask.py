@@ -218,7 +218,7 @@ time_limit: 1.5
           f"past the bound: {len(lost)} run(s) failed (worker lost), the other {12 - len(lost)} completed")
     check(all("KilledWorker" in r["reason"] for r in lost), f"the cause is in the reason: {lost[0]['reason'][:120]}")
     check(outcomes(out)["failed_by_reason"].get("worker lost") == len(lost), "outcomes.json counts them")
-    check(time.monotonic() - T_START < 60, f"test time {time.monotonic() - T_START:.1f} s")
+    check(time.monotonic() - T_START < 110, f"test time {time.monotonic() - T_START:.1f} s (ctest limit 120 s)")
 finally:
     for p in reversed(procs):
         stop(p)
