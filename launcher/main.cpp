@@ -34,6 +34,7 @@
 #include "fsi/common/config.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
+#include "fsi/common/version.hpp"
 
 namespace fs = std::filesystem;
 
@@ -460,16 +461,18 @@ std::string python_interpreter() {
 // the study file passed on unchanged, and this executable as --fsi so every run uses the same
 // build. Replaces this process; returns only on failure.
 int study(const std::vector<std::string>& study_args) {
+  // An installed fsi (PREFIX/bin) uses its own copy (PREFIX/share/fsi/tools, `cmake --install`),
+  // a build tree the sources it was built from.
+  fs::path tool = (self_dir() / ".." / "share" / "fsi" / "tools" / "fsi_study.py").lexically_normal();
 #ifdef FSI_SOURCE_DIR
-  fs::path tool = fs::path(FSI_SOURCE_DIR) / "tools" / "fsi_study.py";
-#else
-  fs::path tool;
+  if (!fs::exists(tool)) tool = fs::path(FSI_SOURCE_DIR) / "tools" / "fsi_study.py";
 #endif
-  if (tool.empty() || !fs::exists(tool)) tool = self_dir() / ".." / ".." / "tools" / "fsi_study.py";
+  if (!fs::exists(tool)) tool = self_dir() / ".." / ".." / "tools" / "fsi_study.py";
   if (!fs::exists(tool)) {
     fsi::logger("fsi")->error("study tool not found: {}", tool.string());
     return 1;
   }
+  fsi::logger("fsi")->debug("study tool: {}", tool.string());
   const std::string self = fs::read_symlink("/proc/self/exe").string();
   std::vector<std::string> args{python_interpreter(), tool.string(), "run"};
   args.insert(args.end(), study_args.begin(), study_args.end());
@@ -488,6 +491,7 @@ int study(const std::vector<std::string>& study_args) {
 int main(int argc, char** argv) {
   CLI::App app{"fsi: partitioned fluid-structure interaction co-simulation"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", fsi::version_line("fsi"));
   auto* run_cmd = app.add_subcommand("run", "run one scene, starting only the processes it needs");
   RunOptions o;
   o.out_dir = "runs/latest";

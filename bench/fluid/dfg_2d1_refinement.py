@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """DFG 2D-1 mesh refinement: DOFs, errors of C_D, C_L, dp against Schafer-Turek, wall time.
 
-Usage (from the repository root, after building fluid_run):
-  python3 bench/fluid/dfg_2d1_refinement.py --runner build/bin/fluid_run --out out/dfg_2d1_refinement
+Usage (from the repository root, after building; each level runs `fsi run SCENE --out OUT/hH --force`):
+  python3 bench/fluid/dfg_2d1_refinement.py --fsi build/bin/fsi --out out/dfg_2d1_refinement
 
 Writes OUT/table.md, OUT/results.json and OUT/error_vs_wall_time.png (the plot needs
 matplotlib: the system /usr/bin/python3 has it; re-plot with --plot-only).
@@ -20,7 +20,7 @@ LEVELS = [(0.04, 0.005), (0.02, 0.0025), (0.01, 0.00125)]
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--runner", default="build/bin/fluid_run")
+    ap.add_argument("--fsi", "--runner", dest="fsi", default="build/bin/fsi", help="the fsi executable")
     ap.add_argument("--scene", default="configs/dfg_2d1.yaml")
     ap.add_argument("--out", default="out/dfg_2d1_refinement")
     ap.add_argument("--levels", type=int, default=len(LEVELS))
@@ -34,7 +34,7 @@ def main():
     results = []
     for h, hc in LEVELS[: a.levels]:
         run_dir = os.path.join(a.out, f"h{h:g}")
-        cmd = [a.runner, a.scene, "--out", run_dir, "--set", f"fluid.mesh.size={h}",
+        cmd = [a.fsi, "run", a.scene, "--out", run_dir, "--force", "--set", f"fluid.mesh.size={h}",
                "--set", f"fluid.mesh.parameters.hc={hc}", "--set", "fluid.output.vtk_every=0"]
         for kv in a.set:
             cmd += ["--set", kv]
@@ -46,11 +46,12 @@ def main():
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         wall = time.time() - t0
         s = json.load(open(os.path.join(run_dir, "summary.json")))
+        final = s["final"]  # the last row of probes.csv
         row = {"h": h, "hc": hc, "dofs": s["dofs"], "wall_seconds": wall, "first_run_seconds": t_first,
-               "solves": s["linear_solves"], "factorisations": s.get("final_factorisations", float("nan"))}
+               "solves": s["solver_iterations"], "factorisations": final.get("fluid.factorisations", float("nan"))}
         for k in REF:
-            row[k] = s["final_" + k]
-            row[k + "_error_percent"] = 100 * (s["final_" + k] / REF[k] - 1)
+            row[k] = final["fluid." + k]
+            row[k + "_error_percent"] = 100 * (final["fluid." + k] / REF[k] - 1)
         results.append(row)
         print(f"h {h:<6g} hc {hc:<8g} dofs {row['dofs']:>7d}  C_D {row['cd']:.5f} ({row['cd_error_percent']:+.3f}%)  "
               f"C_L {row['cl']:.6f} ({row['cl_error_percent']:+.2f}%)  dp {row['dp']:.5f} ({row['dp_error_percent']:+.3f}%)  "

@@ -24,7 +24,7 @@ import sys
 REF = {"cd_max": 2.950921575, "t_cd_max": 3.93625,
        "cl_max": 0.47795, "t_cl_max": 5.693125,
        "dp_final": -0.1116}
-COLUMNS = ("time", "cd", "cl", "dp")
+COLUMNS = ("time", "fluid.cd", "fluid.cl", "fluid.dp")  # as `fsi run` writes them
 T_FINAL = 8.0
 
 
@@ -118,9 +118,9 @@ def compute(t, cd, cl, dp, t_final=T_FINAL):
 
 
 def stats(path, t_final=T_FINAL):
-    """compute() on the columns time, cd, cl, dp of the probes.csv at `path`."""
+    """compute() on the columns time, fluid.cd, fluid.cl, fluid.dp of the probes.csv at `path`."""
     c = read_columns(path)
-    return compute(c["time"], c["cd"], c["cl"], c["dp"], t_final)
+    return compute(c["time"], c["fluid.cd"], c["fluid.cl"], c["fluid.dp"], t_final)
 
 
 def _fmt(v, spec, suffix=""):
@@ -141,7 +141,7 @@ def report(r):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("csv", help="probes.csv with columns time, cd, cl, dp")
+    ap.add_argument("csv", help="probes.csv of `fsi run` with columns time, fluid.cd, fluid.cl, fluid.dp")
     ap.add_argument("--json", metavar="OUT", help="write the values and errors here")
     ap.add_argument("--t-final", type=float, default=T_FINAL, help="time of the dp value (default 8)")
     a = ap.parse_args(argv)

@@ -3,15 +3,15 @@
 on DFG 2D-1 (steady), DFG 2D-2 (periodic) and DFG 2D-3 (John 2004).
 
 Usage (from anywhere; paths default to the repository of this script):
-  python3 bench/fluid/element_benchmark.py [--runner build/bin/fluid_run] [--out out/element_benchmark]
+  python3 bench/fluid/element_benchmark.py [--fsi build/bin/fsi] [--out out/element_benchmark]
       [--cases 2d1 2d2 2d3] [--elements p1p1 p2p1] [--levels 3] [--repeat 3] [--window 2.0]
       [--end T] [--set KEY=VALUE ...] [--reuse] [--plot-only]
 
-Runs: one fluid_run process at a time, OPENBLAS_NUM_THREADS=1, each in its own subdirectory
-of OUT (its output in OUT/RUN/fluid_run.log). The wall time is that of the whole process,
+Runs: one `fsi run SCENE --out OUT/RUN --force` at a time, OPENBLAS_NUM_THREADS=1, each in its
+own subdirectory of OUT (its output in OUT/RUN/fsi_run.log). The wall time is that of the whole process,
 measured here:
   2d1  P1/P1 configs/dfg_2d1.yaml and P2/P1 configs/dfg_2d1_p2p1.yaml at three meshes each
-       (--levels N: the N coarsest); one run meshes (the mesh is cached in the run directory),
+       (--levels N: the N coarsest); one run meshes (the mesh cache, ~/.cache/fsi/meshes),
        then --repeat N timed runs, median. Errors of C_D, C_L, dp against Schafer-Turek.
   2d2  configs/dfg_2d2.yaml / dfg_2d2_p2p1.yaml to t = 10; C_D,max, C_L,max and
        St = f_lift D / U_bar over the last --window seconds (periodic_stats.py). Wall time also
@@ -109,11 +109,13 @@ def percent_error(value, ref):
 
 
 def steady_errors(summary):
-    """DFG 2D-1 values (final_cd, final_cl, final_dp of a summary.json) and their percent errors."""
-    missing = [k for k in ("final_cd", "final_cl", "final_dp", "dofs") if k not in summary]
+    """DFG 2D-1 values (final fluid.cd, fluid.cl, fluid.dp of a summary.json) and their percent errors."""
+    final = summary.get("final", {})
+    missing = [k for k in ("fluid.cd", "fluid.cl", "fluid.dp") if k not in final] + \
+              [k for k in ("dofs",) if k not in summary]
     if missing:
         raise BenchmarkError(f"summary.json has no {', '.join(missing)}")
-    values = {k: float(summary["final_" + k]) for k in REF_2D1}
+    values = {k: float(final["fluid." + k]) for k in REF_2D1}
     errors = {k: percent_error(values[k], REF_2D1[k]) for k in REF_2D1}
     return values, errors
 
@@ -243,24 +245,24 @@ def plan(a):
     return runs
 
 
-def command(runner, run, run_dir):
-    cmd = [runner, run["scene"], "--out", str(run_dir)]
+def command(fsi, run, run_dir):
+    cmd = [fsi, "run", run["scene"], "--out", str(run_dir), "--force"]
     for kv in run["sets"]:
         cmd += ["--set", kv]
     return cmd
 
 
 def run_once(cmd, run_dir):
-    """One fluid_run process (OPENBLAS_NUM_THREADS=1); its wall time in seconds."""
+    """One `fsi run` process (OPENBLAS_NUM_THREADS=1); its wall time in seconds."""
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
-    log_path = run_dir / "fluid_run.log"
+    log_path = run_dir / "fsi_run.log"
     t0 = time.perf_counter()
     with open(log_path, "w") as fh:
         p = subprocess.run(cmd, stdout=fh, stderr=subprocess.STDOUT, env=env)
     wall = time.perf_counter() - t0
     if p.returncode != 0:
         tail = log_path.read_text(errors="replace").strip().splitlines()[-5:]
-        raise BenchmarkError(f"fluid_run exit {p.returncode} in {run_dir} (log {log_path}): " + " / ".join(tail))
+        raise BenchmarkError(f"fsi run exit {p.returncode} in {run_dir} (log {log_path}): " + " / ".join(tail))
     return wall
 
 
@@ -275,10 +277,10 @@ def read_probes(path, columns):
 
 
 def completed(run_dir, end):
-    """The summary.json of a finished run (fluid_run writes it after the last step), or None."""
+    """The summary.json of a completed run, or None."""
     try:
         s = json.load(open(run_dir / "summary.json"))
-        if "final_cd" not in s or "dofs" not in s:
+        if s.get("status") != "completed" or "fluid.cd" not in s.get("final", {}) or "dofs" not in s:
             return None
         if end is not None:
             t = read_probes(run_dir / "probes.csv", ["time"])["time"]
@@ -293,7 +295,7 @@ def execute(run, a, out):
     """Runs (or reuses) one benchmark run; its row for results.json."""
     run_dir = out / run["name"]
     run_dir.mkdir(parents=True, exist_ok=True)
-    cmd = command(a.runner, run, run_dir)
+    cmd = command(a.fsi, run, run_dir)
     record_path = run_dir / "benchmark_run.json"
     row = {k: run[k] for k in ("case", "element", "name", "mesh")}
     row["run_dir"] = str(run_dir)
@@ -326,20 +328,21 @@ def execute(run, a, out):
             log(f"{label}: done, {samples[0]:.1f} s")
         record["wall_samples"] = samples
         if not completed(run_dir, run["end"]):
-            raise BenchmarkError(f"{run_dir}: fluid_run exited 0 but summary.json / probes.csv are incomplete")
+            raise BenchmarkError(f"{run_dir}: fsi run exited 0 but summary.json / probes.csv are incomplete")
         json.dump(record, open(record_path, "w"), indent=2)
     s = json.load(open(run_dir / "summary.json"))
     row.update({"status": "ok", "unknowns": s["dofs"], "wall_samples": record["wall_samples"],
                 "wall_seconds": statistics.median(record["wall_samples"]),
-                "solver_wall_seconds": s.get("wall_seconds"), "setup_seconds": s.get("setup_seconds"),
-                "steps": s.get("steps"), "linear_solves": s.get("linear_solves"),
+                "solver_wall_seconds": s.get("wall_time", {}).get("total"), "setup_seconds": s.get("setup_seconds"),
+                "steps": s.get("steps"), "linear_solves": s.get("solver_iterations"),
                 "fluid_breakdown": s.get("fluid_breakdown", {})})
     if "first_run_seconds" in record:
         row["first_run_seconds"] = record["first_run_seconds"]
     if run["case"] == "2d1":
         row["values"], row["errors"] = steady_errors(s)
     else:
-        c = read_probes(run_dir / "probes.csv", ["time", "cd", "cl", "dp"])
+        c = {k.removeprefix("fluid."): v
+             for k, v in read_probes(run_dir / "probes.csv", ["time", "fluid.cd", "fluid.cl", "fluid.dp"]).items()}
         t_end = c["time"][-1]
         row["end_time"] = t_end
         row["dt"] = t_end / s["steps"] if s.get("steps") else None
@@ -433,7 +436,8 @@ def plot(results, out):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--runner", default=str(ROOT / "build" / "bin" / "fluid_run"))
+    ap.add_argument("--fsi", "--runner", dest="fsi", default=str(ROOT / "build" / "bin" / "fsi"),
+                    help="the fsi executable (default: build/bin/fsi)")
     ap.add_argument("--out", default=str(ROOT / "out" / "element_benchmark"))
     ap.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES))
     ap.add_argument("--elements", nargs="+", choices=ELEMENTS, default=list(ELEMENTS))
@@ -460,9 +464,9 @@ def main(argv=None):
     bad = [kv for kv in a.set if "=" not in kv or kv.startswith("=")]
     if bad:
         sys.exit(f"element_benchmark: --set {bad[0]!r}: expected KEY=VALUE")
-    a.runner = str(Path(a.runner).resolve())
-    if not os.access(a.runner, os.X_OK):
-        sys.exit(f"element_benchmark: runner {a.runner} is not an executable (build fluid_run or pass --runner)")
+    a.fsi = str(Path(a.fsi).resolve())
+    if not os.access(a.fsi, os.X_OK):
+        sys.exit(f"element_benchmark: {a.fsi} is not an executable (build fsi or pass --fsi)")
     runs = plan(a)
     results = []
     for i, run in enumerate(runs, 1):
@@ -476,7 +480,7 @@ def main(argv=None):
         results.append(row)
     doc = {"references": {"2d1": REF_2D1, "2d2": REF_2D2, "2d2_interval_centres": CENTRES_2D2,
                           "2d3": dfg_2d3_stats.REF},
-           "settings": {"runner": a.runner, "repeat": a.repeat, "window": a.window, "end": a.end, "set": a.set,
+           "settings": {"fsi": a.fsi, "repeat": a.repeat, "window": a.window, "end": a.end, "set": a.set,
                         "OPENBLAS_NUM_THREADS": 1},
            "runs": results}
     with open(out / "results.json", "w") as fh:

@@ -32,6 +32,8 @@
 
 #include "fsi/common/config.hpp"
 #include "fsi/common/process.hpp"
+#include "fsi/common/version.hpp"
+#include "fsi/protocol/client.hpp"
 #include "fsi/protocol/remote.hpp"
 #include "fsi/protocol/service.hpp"
 #include "fsi/transport/transport.hpp"
@@ -441,6 +443,8 @@ int main(int argc, char** argv) {
   int warmup = 200, runs = 1;
   double timeout_s = 10;
   std::string out_path;
+  app.set_version_flag("--version", fsi::version_line("bench_messaging") + "\nprotocol fsi.v1, version " +
+                                        std::to_string(fsi::protocol::kProtocolVersion));
   app.add_option("--nodes", nodes, "interface node counts")->expected(1, -1);
   app.add_option("--iterations", iterations, "timed coupling iterations per node count (one value = all)")
       ->expected(1, -1);

@@ -13,6 +13,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+
+#include "fsi/common/version.hpp"
 #include <fstream>
 #include <iostream>
 #include <vector>
@@ -169,6 +171,10 @@ solid:
 int main(int argc, char** argv) {
   try {
     const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "--version") {
+      std::printf("%s\n", fsi::version_line("solid_bench").c_str());
+      return 0;
+    }
     if (mode == "run" && argc > 2) return run(argv[2], std::vector<std::string>(argv + 3, argv + argc));
     if (mode == "timing") return timing(argc > 2 ? argv[2] : "cholmod");
     std::fprintf(stderr, "usage: solid_bench run SCENE [key=value ...] | solid_bench timing [cholmod|umfpack]\n");

@@ -1,5 +1,8 @@
 #include "fsi/common/run_report.hpp"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <fstream>
 
 namespace fsi {
@@ -114,10 +117,13 @@ void ProbeTable::add(double time, const std::map<std::string, double>& probes) {
     }
     csv_ = CsvWriter(path_, header);
   }
-  std::vector<double> row{time};
+  // time = step * dt: 12 significant digits print it without the round-off of the product
+  // (0.06, not 0.060000000000000005) and exactly enough for any dt >= 1e-9 * end; the probes
+  // keep 17 (round trip).
+  std::vector<std::string> row{fmt::format("{:.12g}", time)};
   for (const auto& name : names_) {
     auto it = probes.find(name);
-    row.push_back(it == probes.end() ? std::nan("") : it->second);
+    row.push_back(fmt::format("{:.17g}", it == probes.end() ? std::nan("") : it->second));
   }
   csv_.row(row);
 }

@@ -8,6 +8,7 @@
 #include <csignal>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/log_file.hpp"
 #include "fsi/common/run_report.hpp"
 
 namespace fsi {
@@ -28,10 +29,13 @@ template <class Model, class SetupFn, class StepFn>
 int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::filesystem::path& out_dir,
              const char* runner, const char* section, SetupFn&& setup_fn, StepFn&& step_fn,
              double& compute_time) {
+  add_log_file(out_dir / (std::string(runner) + ".log"));  // OUT/solid_server.log, OUT/fluid_server.log
   auto log = logger(runner);
   RunReport report(out_dir, scene, runner);
   const double start = now_seconds();
   int steps_done = 0;
+  long iterations = 0;  // the solver's nonlinear iterations (Newton / fluid solves), all steps
+  std::map<std::string, double> last;  // the last step's probes, named as in probes.csv
   std::signal(SIGINT, on_standalone_signal);
   std::signal(SIGTERM, on_standalone_signal);
   try {
@@ -40,6 +44,10 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     if (time.checkpoint_every > 0)
       log->warn("time.checkpoint_every: checkpoints are written by coupled runs only; this {} run writes none", section);
     setup_fn(time);
+    report.data()["setup_seconds"] = now_seconds() - start;
+    for (const auto& [k, v] : model->sizes())  // counts: integers in the JSON
+      report.data()[k] = v == std::floor(v) && std::abs(v) < 9e15 ? nlohmann::json(static_cast<std::int64_t>(v))
+                                                                   : nlohmann::json(v);
     if (time.output_every > 0) model->write_output(StepInfo{0.0, time.dt, 0, 0});  // the initial state
     ProbeTable probes(out_dir / "probes.csv");
     Progress progress(runner, time.steps);
@@ -49,23 +57,26 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
                                       g_standalone_signal == SIGINT ? "SIGINT" : "SIGTERM", n)};
       StepInfo info{n * time.dt, time.dt, n, 0};
       const double t0 = now_seconds();
-      auto values = step_fn(info);
+      auto [values, step_iterations] = step_fn(info);
       compute_time += now_seconds() - t0;
+      iterations += step_iterations;
       for (const auto& [k, v] : values)
         if (!std::isfinite(v))
           throw SolverError(fmt::format("probe '{}' is not finite at step {} (t = {})", k, n, info.time));
       std::map<std::string, double> named;
       for (const auto& [k, v] : values) named[std::string(section) + "." + k] = v;
       probes.add(info.time, named);
+      last = std::move(named);
       if (time.output_every > 0 && n % time.output_every == 0) model->write_output(info);
       steps_done = n;
       report.data()["steps"] = steps_done;
+      report.data()["solver_iterations"] = iterations;
       if (n == time.steps || n % 10 == 0) {
         report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
         if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
         report.write();
       }
-      progress.update(n, info.time);
+      progress.update(n, info.time, fmt::format("iterations {}", step_iterations));
     }
     report.set_status("completed");
     report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
@@ -80,6 +91,8 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     report.set_status("failed", e.what());
   }
   report.data()["steps"] = steps_done;
+  report.data()["solver_iterations"] = iterations;
+  if (!last.empty()) report.data()["final"] = last;  // the last row of probes.csv
   report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
         if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
   report.write();
@@ -146,8 +159,8 @@ int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const 
       },
       [&](const StepInfo& info) {
         const auto n = model->interface().nodes();
-        model->solve_step(info, Eigen::VectorXd::Zero(2 * n));
-        return model->accept_step(info);
+        const int newton = model->solve_step(info, Eigen::VectorXd::Zero(2 * n)).newton_iterations;
+        return std::pair{model->accept_step(info), newton};
       },
       compute);
 }
@@ -166,8 +179,9 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
       },
       [&](const StepInfo& info) {
         const auto n = model->interface().nodes();
-        model->solve_step(info, Eigen::VectorXd::Zero(2 * n), Eigen::VectorXd::Zero(2 * n));
-        return model->accept_step(info);
+        const int solves =
+            model->solve_step(info, Eigen::VectorXd::Zero(2 * n), Eigen::VectorXd::Zero(2 * n)).nonlinear_iterations;
+        return std::pair{model->accept_step(info), solves};
       },
       compute);
 }

@@ -17,9 +17,11 @@
 #include <fstream>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/version.hpp"
 #include "fsi/common/process.hpp"
 #include "fsi/common/run_report.hpp"
 #include "fsi/coupling/coupler.hpp"
+#include "fsi/protocol/client.hpp"
 #include "fsi/protocol/remote.hpp"
 #include "fsi/transport/transport.hpp"
 
@@ -36,6 +38,8 @@ int main(int argc, char** argv) {
   double timeout = 600, connect_timeout = 20;
   bool resume = false, force = false, recoverable = false, fresh_start = false, out_ready = false;
   std::string curve_keys, generate_keys;
+  app.set_version_flag("--version", fsi::version_line("coupler") + "\nprotocol fsi.v1, version " +
+                                        std::to_string(fsi::protocol::kProtocolVersion));
   app.add_option("scene", scene_path, "scene file (configs/*.yaml)")->required();
   app.add_option("--solid", solid_endpoint, "solid server endpoint, e.g. tcp://127.0.0.1:5555")
       ->required();

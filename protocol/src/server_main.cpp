@@ -4,6 +4,8 @@
 
 #include "fsi/common/log.hpp"
 #include "fsi/common/process.hpp"
+#include "fsi/common/version.hpp"
+#include "fsi/protocol/client.hpp"
 #include "fsi/transport/transport.hpp"
 
 namespace fsi::protocol {
@@ -17,6 +19,8 @@ int server_main(int argc, char** argv, const ServerProgram& program) {
   std::vector<std::string> overrides;
   double idle_timeout = 0;
   std::string curve_keys;
+  app.set_version_flag("--version", fsi::version_line(name) + "\nprotocol fsi.v1, version " +
+                                        std::to_string(kProtocolVersion));
   app.add_option("--bind", bind, "endpoint to bind (tcp://HOST:PORT, port * = any free port)");
   app.add_option("--port-file", port_file, "write the bound endpoint to this file");
   app.add_option("--idle-timeout", idle_timeout,

@@ -39,15 +39,15 @@ def load(name, path):
     return mod
 
 
-def write_csv(path, dt, t_last, columns=("time", "cd", "cl", "dp", "drag")):
+def write_csv(path, dt, t_last, columns=("time", "fluid.cd", "fluid.cl", "fluid.dp", "fluid.drag")):
     n = int(round(t_last / dt))
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(columns)
         for i in range(n + 1):
             t = i * dt
-            v = {"time": t, "cd": 2.95 - (t - 3.93625) ** 2, "cl": 0.47 - 3 * (t - 5.693125) ** 2,
-                 "dp": -0.11 + 0.002 * (t - 8.0), "drag": 0.0}
+            v = {"time": t, "fluid.cd": 2.95 - (t - 3.93625) ** 2, "fluid.cl": 0.47 - 3 * (t - 5.693125) ** 2,
+                 "fluid.dp": -0.11 + 0.002 * (t - 8.0), "fluid.drag": 0.0}
             w.writerow([repr(v[c]) for c in columns])
 
 
@@ -103,9 +103,9 @@ check(p.returncode == 0 and r.get("complete") is False and r["errors"]["dp_final
 
 # --- bad input: the missing column and the file are named, non-zero exit
 nocl = work / "nocl.csv"
-write_csv(nocl, 0.01, 8.0, columns=("time", "cd", "dp"))
+write_csv(nocl, 0.01, 8.0, columns=("time", "fluid.cd", "fluid.dp"))
 p = run(SCRIPT, nocl)
-check(p.returncode != 0 and "no column cl" in p.stderr and "nocl.csv" in p.stderr,
+check(p.returncode != 0 and "no column fluid.cl" in p.stderr and "nocl.csv" in p.stderr,
       f"missing column: exit {p.returncode}, '{p.stderr.strip()}'")
 p = run(SCRIPT, work / "does_not_exist.csv")
 check(p.returncode != 0 and "does_not_exist.csv" in p.stderr, f"missing file: exit {p.returncode}, '{p.stderr.strip()}'")
@@ -113,15 +113,15 @@ check(p.returncode != 0 and "does_not_exist.csv" in p.stderr, f"missing file: ex
 # --- element_benchmark: pure functions on fake data
 eb = load("element_benchmark", BENCHMARK)
 ref = eb.REF_2D1
-summary = {"dofs": 1234, "final_cd": ref["cd"] * 1.01, "final_cl": ref["cl"] * 0.98, "final_dp": ref["dp"]}
+summary = {"dofs": 1234, "final": {"fluid.cd": ref["cd"] * 1.01, "fluid.cl": ref["cl"] * 0.98, "fluid.dp": ref["dp"]}}
 values, errors = eb.steady_errors(summary)
 check(abs(errors["cd"] - 1.0) < 1e-9 and abs(errors["cl"] + 2.0) < 1e-9 and abs(errors["dp"]) < 1e-12,
       f"2D-1 errors from a fake summary: {errors}")
 try:
-    eb.steady_errors({"dofs": 1, "final_cd": 1.0})
-    check(False, "summary without final_cl / final_dp raises")
+    eb.steady_errors({"dofs": 1, "final": {"fluid.cd": 1.0}})
+    check(False, "summary without fluid.cl / fluid.dp raises")
 except eb.BenchmarkError as ex:
-    check("final_cl" in str(ex) and "final_dp" in str(ex), f"summary without final_cl / final_dp: '{ex}'")
+    check("fluid.cl" in str(ex) and "fluid.dp" in str(ex), f"summary without fluid.cl / fluid.dp: '{ex}'")
 check(eb.percent_error(float("nan"), 1.0) is None and eb.percent_error(None, 1.0) is None
       and abs(eb.percent_error(-0.12, -0.1) - (-20.0)) < 1e-9, "percent_error: None for NaN / None, (v - ref) / |ref|")
 
@@ -141,7 +141,7 @@ check(abs(errors["cl_max_centre"] - 100 * (0.98658 - 1.0)) < 1e-2 and abs(errors
 
 # DFG 2D-3 through dfg_2d3_stats.compute.
 c = s23.read_columns(str(full))
-v3, e3 = eb.john_errors(s23.compute(c["time"], c["cd"], c["cl"], c["dp"]))
+v3, e3 = eb.john_errors(s23.compute(c["time"], c["fluid.cd"], c["fluid.cl"], c["fluid.dp"]))
 check(abs(v3["t_cd_max"] - 3.93625) < 1e-9 and e3["dp_final"] is not None, "2D-3 values / errors via john_errors")
 
 rows = [
@@ -152,7 +152,7 @@ rows = [
     {"case": "2d2", "element": "p2p1", "mesh": "h 0.05, hc 0.006", "status": "ok", "unknowns": 5000,
      "wall_seconds": 100.0, "wall_per_simulated_second": 10.0, "errors": errors},
     {"case": "2d3", "element": "p1p1", "mesh": "h 0.02, hc 0.0025", "status": "failed",
-     "error": "fluid_run exit 1: fluid.stabilisation.grad_div: is a P2/P1 setting"},
+     "error": "fsi run exit 1: fluid.stabilisation.grad_div: is a P2/P1 setting"},
     {"case": "2d3", "element": "p2p1", "mesh": "h 0.05, hc 0.006", "status": "ok", "unknowns": 7000,
      "wall_seconds": 80.0, "wall_per_simulated_second": 10.0, "errors": e3},
 ]
@@ -161,7 +161,7 @@ print(table)
 lines = [ln for ln in table.splitlines() if ln.startswith("|")]
 check("| 2d1 | P1/P1 | h 0.04, hc 0.005 | 1234 | 2.50 | +1.000 | -2.000 | n/a |" in table, "2D-1 row: errors, n/a for None")
 check("| 2d2 | P2/P1 | h 0.05, hc 0.006 | 5000 | 100.00 | 10.00 |" in table, "2D-2 row: wall and s per simulated s")
-check("failed: fluid_run exit 1" in table, "failed run shown in the table")
+check("failed: fsi run exit 1" in table, "failed run shown in the table")
 by_table = {}
 for ln in table.splitlines():
     if ln.startswith("### "):
@@ -180,7 +180,7 @@ json.dump({"runs": rows}, open(eb_out / "results.json", "w"))
 p = run(BENCHMARK, "--out", eb_out, "--plot-only")
 check(p.returncode == 0 and (eb_out / "table.md").exists() and (eb_out / "error_vs_wall_time.png").exists()
       and "| 2d1 | P2/P1 |" in p.stdout, f"--plot-only: exit {p.returncode}, table and plot ({p.stderr.strip()[-300:]})")
-p = run(BENCHMARK, "--out", work / "eb_norunner", "--runner", work / "no_fluid_run", "--cases", "2d1")
-check(p.returncode != 0 and "no_fluid_run" in p.stderr, f"missing runner: exit {p.returncode}, '{p.stderr.strip()}'")
+p = run(BENCHMARK, "--out", work / "eb_norunner", "--fsi", work / "no_fsi", "--cases", "2d1")
+check(p.returncode != 0 and "no_fsi" in p.stderr, f"missing runner: exit {p.returncode}, '{p.stderr.strip()}'")
 
 sys.exit(1 if failures else 0)

@@ -505,8 +505,9 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
     std::string extra;
     for (const auto& [k, v] : probes)
       if (k != "nonlinear_change" && k != "nonlinear_iterations" && k != "factorisations") extra += fmt::format(" {}={:.6g}", k, v);
-    fsi::logger("fluid")->info("step {} t={:.4f}/{:.4g} ({:.0f}%) elapsed {:.1f}s ETA {:.1f}s |{}", info.step, info.time,
-                               setup_.end_time, 100 * done, elapsed, eta, extra);
+    // Debug only: the runner's progress line (step, time, iterations, ETA) is the one at info.
+    fsi::logger("fluid")->debug("step {} t={:.4f}/{:.4g} ({:.0f}%) elapsed {:.1f}s ETA {:.1f}s |{}", info.step,
+                                info.time, setup_.end_time, 100 * done, elapsed, eta, extra);
   }
   return probes;
 }

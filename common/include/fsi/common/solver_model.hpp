@@ -89,6 +89,8 @@ class SolidModel {
   // Cumulative wall seconds by category (e.g. "assembly", "linear_solve"), reported in
   // the run summary. Optional.
   virtual std::map<std::string, double> timings() const { return {}; }
+  // Problem size for summary.json after configure() (e.g. "dofs", "nodes", "elements").
+  virtual std::map<std::string, double> sizes() const { return {}; }
   // Checkpoints: the state after the last accepted step; see the call order above.
   virtual bool supports_checkpoint() const { return false; }
   virtual void save_state(StateArchive& /*state*/) { unsupported_checkpoint(name()); }
@@ -138,6 +140,8 @@ class FluidModel {
   virtual bool supports_output() const { return true; }
   // Cumulative wall seconds by category (e.g. "mesh_motion", "assembly", "linear_solve").
   virtual std::map<std::string, double> timings() const { return {}; }
+  // Problem size for summary.json after configure() (e.g. "dofs", "nodes", "triangles").
+  virtual std::map<std::string, double> sizes() const { return {}; }
   // Checkpoints: the state after the last accepted step; see the call order above.
   virtual bool supports_checkpoint() const { return false; }
   virtual void save_state(StateArchive& /*state*/) { unsupported_checkpoint(name()); }

@@ -62,6 +62,13 @@ class NavierStokesFluid : public FluidModel {
     return {{"mesh_motion", motion_ ? motion_->seconds() : 0.0}, {"assembly", assembly_seconds_},
             {"factorisation", factor_seconds_}, {"linear_solve", linear_solve_seconds_}, {"step", solve_seconds_}};
   }
+  // Unknowns, mesh nodes and triangles (summary.json of standalone runs).
+  std::map<std::string, double> sizes() const override {
+    if (!solver_) return {};
+    return {{"dofs", solver_->dofs()},
+            {"nodes", solver_->mesh().node_count()},
+            {"triangles", solver_->mesh().triangle_count()}};
+  }
 
  private:
   struct ForceProbe {
