@@ -24,6 +24,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <thread>
 #include <vector>
 
@@ -34,6 +35,8 @@
 #include "fsi/common/config.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
+#include "check.hpp"
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/version.hpp"
 
 namespace fs = std::filesystem;
@@ -269,6 +272,26 @@ struct RunOptions {
 
 int run(const RunOptions& o) {
   auto log = fsi::logger("fsi");
+  // Every key of every section against the scene schema, before anything starts (fsi check);
+  // the sections an external solver reads are its own business.
+  std::vector<std::string> external;
+  if (!o.solid_command.empty()) external.push_back("solid");
+  if (!o.fluid_command.empty()) external.push_back("fluid");
+  std::string problems;
+  if (!fsi::launcher::check_before_run(o.scene_path, o.overrides, external, problems)) {
+    // Nothing was started; the summary says why, as for every other way a run ends (a run to
+    // resume keeps the summary it has).
+    try {
+      if (!o.resume) {
+        const auto scene = fsi::Scene::load(o.scene_path, o.overrides);
+        fsi::prepare_output_dir(o.out_dir, o.force ? fsi::OutputMode::Force : fsi::OutputMode::Fresh);
+        finalize_summary(o.out_dir, scene, "failed", "configuration: " + problems, false);
+      }
+    } catch (const std::exception&) {
+      // An unreadable scene or a refused --out: the problems above are the whole story.
+    }
+    return 1;
+  }
   const auto scene = fsi::Scene::load(o.scene_path, o.overrides);  // fails early on a bad file
   const bool has_solid = scene.has("solid"), has_fluid = scene.has("fluid"), coupled = scene.has("coupling");
   const fs::path out(o.out_dir), bin = self_dir();
@@ -519,6 +542,16 @@ int main(int argc, char** argv) {
   std::string keys_dir;
   keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")
       ->required();
+  auto* check_cmd = app.add_subcommand(
+      "check", "check a scene (or a study's scene with its fixed and varied keys) against the scene schema, "
+               "without meshing or starting a solver: fsi check SCENE|STUDY [--set key=value ...]");
+  std::string check_file;
+  std::vector<std::string> check_overrides;
+  bool check_reference = false;
+  check_cmd->add_option("file", check_file, "scene (configs/*.yaml) or study (studies/*.yaml)");
+  check_cmd->add_option("--set", check_overrides, "override any scene key: dotted.key=value (repeatable)");
+  check_cmd->add_flag("--reference", check_reference,
+                      "print the scene reference (Markdown, docs/scene-reference.md) from the schema");
   auto* study_cmd = app.add_subcommand(
       "study", "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
                "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
@@ -534,6 +567,17 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (study_cmd->parsed()) return study(study_cmd->remaining());
+  if (check_cmd->parsed()) {
+    if (check_reference) {
+      std::cout << fsi::schema::reference_markdown();
+      return 0;
+    }
+    if (check_file.empty()) {
+      std::cerr << "fsi check: give a scene or study file (or --reference)\n";
+      return 1;
+    }
+    return fsi::launcher::check_file(check_file, check_overrides);
+  }
   if (keys_cmd->parsed()) {
     if (fs::exists(fs::path(keys_dir) / "server.key_secret") || fs::exists(fs::path(keys_dir) / "coupler.key_secret")) {
       fsi::logger("fsi")->error("{} already holds keys: remove them first or choose another folder", keys_dir);

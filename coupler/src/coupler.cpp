@@ -71,6 +71,7 @@ RunOutcome Coupler::run(RunReport& report) {
   try {
     // 1. Read the scene's coupling part; configure both solvers.
     scene_.name();
+    schema::require_valid(scene_, {"time", "coupling"});  // every key, before anything is configured
     const TimeSettings time = read_time(scene_);
     settings_ = read_coupling(scene_.section("coupling"));
     scene_.check_all_used("coupling");

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi {
@@ -19,6 +20,7 @@ using FluidFactory = std::function<std::unique_ptr<FluidModel>(const std::string
 template <class Model>
 std::unique_ptr<Model> make_model(const std::function<std::unique_ptr<Model>(const std::string&)>& factory,
                                   const ConfigSection& section, const char* kind) {
+  schema::require_valid(section);  // every key of the section, before the model builds anything
   const auto name = section.get<std::string>("model");
   auto model = factory(name);
   if (!model) section.fail("model", std::string("names no ") + kind + " model this server knows ('" + name + "')");

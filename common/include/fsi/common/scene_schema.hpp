@@ -1,0 +1,134 @@
+#pragma once
+// The scene schema: every key of every section (time, coupling, solid, fluid and the keys of
+// each solver model), with its type, default, unit, allowed values, meaning and whether it is
+// required. It is the single source of truth for
+//   - `fsi check SCENE` (and `fsi run`, which checks first): every key validated without
+//     meshing or starting a process;
+//   - the servers and the coupler, which validate their section against it before they build
+//     anything (the readers' own check_all_used() stays as the backstop);
+//   - docs/scene-reference.md (`fsi check --reference`).
+//
+// A solver section's keys depend on its `model` (solid: sdof, fem; fluid: surrogate, fem);
+// some keys depend on another key (fluid.element, solid.mesh.type, ...): `when` below.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fsi/common/config.hpp"
+
+namespace fsi::schema {
+
+enum class Type {
+  Number,           // a finite number
+  Integer,          // a whole number
+  Bool,             // true / false
+  String,           // any text
+  Enum,             // one of `allowed`
+  Vector2,          // [x, y]
+  NumberOrVector2,  // x (y = 0) or [x, y]
+  Names,            // a name or a list of names
+  StringList,       // a list of names
+  IntList,          // a list of `size` integers
+  PointPair,        // [[x0, y0], [x1, y1]]
+  Section,          // a map of the `children` keys
+  SectionList,      // a list of maps of the `children` keys
+  NamedMap,         // a map from names the user chooses to values of children[0]
+};
+
+// A key is used only when another key has one of `values` (empty: when it is given at all).
+// `key` without a dot names a key of the same map, with dots a key from the scene's root.
+struct Condition {
+  std::string key;
+  std::vector<std::string> values;
+  std::string fallback;  // the other key's value when it is absent
+};
+
+struct Key {
+  std::string name;
+  Type type = Type::Number;
+  bool required = false;
+  std::string default_value;  // as documented ("" = none)
+  std::string unit;
+  std::string meaning;
+  std::vector<std::string> allowed;  // Enum; Number/Integer: the only values allowed
+  std::optional<double> lo, hi;
+  bool lo_open = false, hi_open = false;
+  std::string range_message;  // instead of "must be > 0" etc., e.g. "(beta) must be > 0"
+  std::string one_of;  // exactly one key of the same group (in the same map) must be given
+  std::vector<Condition> when;
+  std::vector<Key> children;  // Section, SectionList; NamedMap: one entry, the value
+  int size = 0;               // IntList, StringList: the number of entries (0 = any)
+  // Sections whose keys depend on one of their keys (solid.model): that key and its variants.
+  std::string selector;
+  struct Variant;
+  std::vector<Variant> variants;
+
+  Key& req() { required = true; return *this; }
+  Key& def(std::string d) { default_value = std::move(d); return *this; }
+  Key& in_unit(std::string u) { unit = std::move(u); return *this; }
+  Key& values(std::vector<std::string> v) { allowed = std::move(v); return *this; }
+  Key& gt(double v) { lo = v; lo_open = true; return *this; }
+  Key& ge(double v) { lo = v; lo_open = false; return *this; }
+  Key& lt(double v) { hi = v; hi_open = true; return *this; }
+  Key& le(double v) { hi = v; hi_open = false; return *this; }
+  Key& says(std::string m) { range_message = std::move(m); return *this; }
+  Key& group(std::string g) { one_of = std::move(g); return *this; }
+  Key& only_when(std::string key, std::vector<std::string> vals = {}, std::string fallback = "") {
+    when.push_back({std::move(key), std::move(vals), std::move(fallback)});
+    return *this;
+  }
+  Key& with(std::vector<Key> c) { children = std::move(c); return *this; }
+  Key& count(int n) { size = n; return *this; }
+};
+
+struct Key::Variant {
+  std::string value;    // e.g. "fem"
+  std::string meaning;  // one line for the reference
+  std::vector<Key> keys;
+};
+
+// The scene's top-level keys (scene, description, time, coupling, solid, fluid).
+const std::vector<Key>& scene_keys();
+
+struct Problem {
+  std::string where;    // "file:line:col", "file (--set key=value)", or "" when in message
+  std::string message;
+  std::string key;      // dotted key the problem is about ("" = the scene)
+  std::string text() const { return where.empty() ? message : where + ": " + message; }
+};
+
+struct CheckOptions {
+  // Sections not checked (e.g. "solid" when an external solid, with keys of its own, is used).
+  std::vector<std::string> skip_sections;
+  // Check only these top-level sections ("" entries ignored; empty = every section).
+  std::vector<std::string> only_sections;
+  // Where an override came from, when not from the command line: "key=value" -> "file:line:col".
+  std::vector<std::pair<std::string, std::string>> override_origins;
+};
+
+struct CheckResult {
+  std::vector<Problem> problems;
+  int keys_checked = 0;
+  bool ok() const { return problems.empty(); }
+};
+
+// Every problem of the scene (unknown keys with a suggestion, missing required keys, wrong
+// types, values out of range, keys of another model or element), in file order per section.
+CheckResult check_scene(const Scene& scene, const CheckOptions& options = {});
+
+// Throws one ConfigError listing every problem of the section(s) (for the servers and the
+// coupler, before they build anything). Does nothing for a section name the schema does not
+// know (a server started for another section name).
+void require_valid(const Scene& scene, const std::vector<std::string>& sections);
+// The same for the scene section a solver server is about to configure; a `model` the schema
+// does not know is left to the server's factory.
+void require_valid(const ConfigSection& section);
+
+// docs/scene-reference.md.
+std::string reference_markdown();
+
+// Levenshtein distance; and the closest of `candidates` to `word` if close enough ("" = none).
+std::size_t edit_distance(const std::string& a, const std::string& b);
+std::string closest(const std::string& word, const std::vector<std::string>& candidates);
+
+}  // namespace fsi::schema

@@ -1,0 +1,86 @@
+// The scene schema: suggestions, problems with their places, the servers' pre-check.
+#include <gtest/gtest.h>
+
+#include "fsi/common/scene_schema.hpp"
+#include "fsi/common/standalone.hpp"
+
+namespace {
+
+std::vector<std::string> problems(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  std::vector<std::string> out;
+  for (const auto& p : fsi::schema::check_scene(fsi::Scene::parse(text, "s.yaml", overrides)).problems)
+    out.push_back(p.text());
+  return out;
+}
+
+const std::string kScene =
+    "time: {dt: 0.1, end: 1.0}\n"
+    "coupling:\n"
+    "  algorithm: 2\n"
+    "  gamma_n1: 10\n"
+    "  relaxation: 1.0\n"
+    "  iterations: {max: 1}\n"
+    "solid:\n"
+    "  model: sdof\n"
+    "  mass: 1.0\n"
+    "fluid:\n"
+    "  model: surrogate\n"
+    "  force: [1.0, 0.0]\n";
+
+TEST(SceneSchema, EditDistanceAndSuggestion) {
+  EXPECT_EQ(fsi::schema::edit_distance("max_iteratons", "max_iterations"), 1u);
+  EXPECT_EQ(fsi::schema::edit_distance("", "abc"), 3u);
+  EXPECT_EQ(fsi::schema::closest("materal", {"mesh", "material", "density"}), "material");
+  EXPECT_EQ(fsi::schema::closest("zzzzzz", {"mesh", "material"}), "");
+  EXPECT_EQ(fsi::schema::closest("mesh", {"mesh"}), "");  // the word itself is no suggestion
+}
+
+TEST(SceneSchema, ValidSceneCountsItsKeys) {
+  const auto r = fsi::schema::check_scene(fsi::Scene::parse(kScene, "s.yaml"));
+  EXPECT_TRUE(r.ok());
+  EXPECT_EQ(r.keys_checked, 15);  // 4 sections + 2 time + 4 coupling + 1 iterations + 2 solid + 2 fluid
+}
+
+TEST(SceneSchema, ProblemsNameKeyPlaceAndSuggestion) {
+  std::string text = kScene;
+  text.replace(text.find("  mass: 1.0"), 11, "  mass: heavy\n  stifness: 2");
+  EXPECT_EQ(problems(text), (std::vector<std::string>{
+                                "s.yaml:9:3: 'solid.mass' must be a number, got 'heavy'",
+                                "s.yaml:10:3: unknown key 'solid.stifness' (did you mean 'stiffness'?)",
+                            }));
+  EXPECT_EQ(problems(kScene, {"fluid.added_mass=-1", "coupling.iqn.filter=0.5"}),
+            (std::vector<std::string>{
+                "s.yaml (--set coupling.iqn.filter=0.5): 'coupling.iqn' is only used when 'coupling.acceleration' "
+                "is iqn-ils",
+                "s.yaml (--set fluid.added_mass=-1): 'fluid.added_mass' must be >= 0, got '-1'",
+            }));
+  EXPECT_EQ(problems("time: {dt: 0.1, end: 1.0}\nsolid: {model: sdof, mass: 1}\nfluid: {model: surrogate}\n"),
+            (std::vector<std::string>{"s.yaml: a scene without 'coupling' must have exactly one of 'solid' or "
+                                      "'fluid'"}));
+}
+
+TEST(SceneSchema, ServersValidateTheirSectionBeforeBuilding) {
+  std::string text = kScene;
+  text.replace(text.find("  mass: 1.0"), 11, "  mass: 1.0\n  dampng: 2");
+  const auto scene = fsi::Scene::parse(text, "s.yaml");
+  try {
+    fsi::schema::require_valid(scene.section("solid"));
+    FAIL() << "no error";
+  } catch (const fsi::ConfigError& e) {
+    EXPECT_STREQ(e.what(), "s.yaml:10:3: unknown key 'solid.dampng' (did you mean 'damping'?)");
+  }
+  // Other sections are not its business; a model the schema does not know is the factory's.
+  EXPECT_NO_THROW(fsi::schema::require_valid(scene.section("fluid")));
+  const auto other = fsi::Scene::parse("solid: {model: mine, anything: 1}\n", "o.yaml");
+  EXPECT_NO_THROW(fsi::schema::require_valid(other.section("solid")));
+}
+
+TEST(SceneSchema, ReferenceListsEveryModel) {
+  const std::string md = fsi::schema::reference_markdown();
+  for (const char* heading : {"## time", "## coupling", "### solid.model: sdof", "### solid.model: fem",
+                              "### fluid.model: surrogate", "### fluid.model: fem"})
+    EXPECT_NE(md.find(heading), std::string::npos) << heading;
+  EXPECT_NE(md.find("| `fluid.nonlinear.max_iterations` | integer |  | `1` |"), std::string::npos);
+}
+
+}  // namespace
