@@ -1,6 +1,7 @@
 // libFuzzer target: bytes -> fsi::Scene::parse plus the reads a coupled run does on it
 // (Scene::name, read_time, read_coupling, check_all_used, the top-level keys, and typed reads
-// of solid/fluid keys as the models do: get<T>, read_vector2, child, list, get_path).
+// of solid/fluid keys as the models do: get<T>, read_vector2, child, list, get_path), and the
+// scene schema's check (fsi check).
 //
 // Input: the scene text, optionally followed by '\0' and up to 8 '\0'-separated --set
 // overrides ("solid.mass=2").
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/coupling/settings.hpp"
 
@@ -93,5 +95,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (const char* name : {"solid", "fluid"})
     expect_config_errors_only("section", [&] { read_model_section(s.section(name)); });
   expect_config_errors_only("check_all_used", [&] { s.check_all_used(); });
+  expect_config_errors_only("schema::check_scene", [&] { (void)fsi::schema::check_scene(s); });
+  expect_config_errors_only("schema::require_valid", [&] { fsi::schema::require_valid(s, {"time", "coupling", "solid", "fluid"}); });
   return 0;
 }

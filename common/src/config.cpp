@@ -1,4 +1,5 @@
 #include "fsi/common/config.hpp"
+#include "fsi/common/scene_schema.hpp"
 
 #include <cmath>
 #include <map>
@@ -79,7 +80,15 @@ void collect_unused(const YAML::Node& node, const std::string& path,
     const std::string key = kv.first.Scalar();
     const std::string full = path.empty() ? key : path + "." + key;
     if (!used.count(full)) {
-      unknown.push_back("'" + full + "' at " + mark_string(origin, kv.first.Mark()));
+      // The closest key read next to it, if it is a likely typo of one.
+      std::vector<std::string> siblings;
+      const std::string prefix = path.empty() ? "" : path + ".";
+      for (const auto& u : used)
+        if (u.rfind(prefix, 0) == 0 && u.find_first_of(".[", prefix.size()) == std::string::npos)
+          siblings.push_back(u.substr(prefix.size()));
+      const std::string suggestion = schema::closest(key, siblings);
+      unknown.push_back("'" + full + "' at " + mark_string(origin, kv.first.Mark()) +
+                        (suggestion.empty() ? "" : " (did you mean '" + suggestion + "'?)"));
     } else if (kv.second.IsMap()) {
       collect_unused(kv.second, full, used, origin, unknown);
     } else if (kv.second.IsSequence()) {

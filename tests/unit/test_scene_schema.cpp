@@ -75,6 +75,19 @@ TEST(SceneSchema, ServersValidateTheirSectionBeforeBuilding) {
   EXPECT_NO_THROW(fsi::schema::require_valid(other.section("solid")));
 }
 
+TEST(SceneSchema, CheckAllUsedSuggestsAKeyTheReaderRead) {
+  const auto scene = fsi::Scene::parse("solid:\n  mass: 1\n  dampng: 2\n", "t.yaml");
+  const auto s = scene.section("solid");
+  s.get<double>("mass");
+  s.get<double>("damping", 0.0);
+  try {
+    scene.check_all_used("solid");
+    FAIL() << "no error";
+  } catch (const fsi::ConfigError& e) {
+    EXPECT_STREQ(e.what(), "unknown key in scene: 'solid.dampng' at t.yaml:3:3 (did you mean 'damping'?)");
+  }
+}
+
 TEST(SceneSchema, ReferenceListsEveryModel) {
   const std::string md = fsi::schema::reference_markdown();
   for (const char* heading : {"## time", "## coupling", "### solid.model: sdof", "### solid.model: fem",
