@@ -1,5 +1,5 @@
 #pragma once
-// FemSolid: the finite-strain Q4 solid as an fsi::SolidModel (issue 3).
+// FemSolid: the finite-strain Q4 solid as an fsi::SolidModel.
 //
 // Call order (the contract of solver_model.hpp):
 //   configure(section, setup) -> interface() -> { solve_step(info, F) ... accept_step(info) } -> write_output(info)
