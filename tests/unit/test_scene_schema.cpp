@@ -3,6 +3,9 @@
 
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
+#include "fsi/coupling/settings.hpp"
+#include "fsi/models/fluid_factory.hpp"
+#include "fsi/models/solid_factory.hpp"
 
 namespace {
 
@@ -86,6 +89,59 @@ TEST(SceneSchema, CheckAllUsedSuggestsAKeyTheReaderRead) {
   } catch (const fsi::ConfigError& e) {
     EXPECT_STREQ(e.what(), "unknown key in scene: 'solid.dampng' at t.yaml:3:3 (did you mean 'damping'?)");
   }
+}
+
+// The schema and the readers agree: a scene with every key of a model passes the check, and
+// the model reads every one of them (check_all_used, the readers' own test).
+TEST(SceneSchema, EveryKeyOfTheSchemaIsReadByItsModel) {
+  const std::string text =
+      "time: {dt: 0.1, end: 0.2, output_every: 0, checkpoint_every: 0, checkpoint_keep: 2}\n"
+      "coupling: {algorithm: 2, gamma_n1: 10, gamma_n2: -1, relaxation: 1.0, predictor: previous,\n"
+      "           acceleration: iqn-ils, iqn: {reuse_steps: 4, filter: 0.01}, force_limit: 1.0e9,\n"
+      "           iterations: {max: 3, tolerance: 1.0e-6, stop_if_not_converged: false, divergence_factor: 100}}\n"
+      "solid: {model: sdof, mass: 1, damping: 0.1, stiffness: 2, interface_measure: 1, force: [1, 0],\n"
+      "        initial_displacement: 0.1, initial_velocity: [0, 0.5]}\n"
+      "fluid: {model: surrogate, force: 1.0, added_mass: 0.5, interface_measure: 1}\n"
+      "fem:\n"
+      "  model: fem\n"
+      "  mesh: {type: rectangle, origin: [0, 0], size: [1, 0.1], elements: [4, 1]}\n"
+      "  material: {law: neo_hookean, youngs_modulus: 1.0e6, poisson_ratio: 0.3}\n"
+      "  density: 1000\n"
+      "  gravity: [0, -1]\n"
+      "  analysis: dynamic\n"
+      "  time_scheme: bdf2\n"
+      "  load_steps: 1\n"
+      "  newton: {max_iterations: 10, residual_tolerance: 1.0e-8, increment_tolerance: 1.0e-12}\n"
+      "  linear_solver: umfpack\n"
+      "  clamp: left\n"
+      "  interface: [top, right]\n"
+      "  tractions: [{boundary: right, traction: [0, 1]}]\n"
+      "  point_loads: [{point: [1, 0.1], force: [0, 1]}]\n"
+      "  probes: [{name: A, point: [0.9, 0.05]}]\n"
+      "  output_every: 1\n";
+  // The fem solid in place of the sdof one (the schema checks `solid`).
+  std::string fem = text.substr(text.find("fem:\n") + 5);
+  std::string as_solid = text.substr(0, text.find("solid:")) + "solid:\n" + fem + text.substr(text.find("fluid:"),
+                                                                                                  text.find("fem:") -
+                                                                                                      text.find("fluid:"));
+  for (const auto& scene_text : {text.substr(0, text.find("fem:")), as_solid}) {
+    const auto scene = fsi::Scene::parse(scene_text, "all.yaml");
+    const auto r = fsi::schema::check_scene(scene);
+    ASSERT_TRUE(r.ok()) << r.problems.front().text();
+    const auto solid = scene.section("solid");
+    auto model = fsi::make_model(fsi::SolidFactory(fsi::models::make_solid_model), solid, "solid");
+    model->configure(solid, fsi::SolidSetup{0.1, 0.2, 0.0, {}});
+    EXPECT_NO_THROW(scene.check_all_used("solid"));
+  }
+  const auto scene = fsi::Scene::parse(text.substr(0, text.find("fem:")), "all.yaml");
+  const auto fluid = scene.section("fluid");
+  auto model = fsi::make_model(fsi::FluidFactory(fsi::models::make_fluid_model), fluid, "fluid");
+  model->configure(fluid, fsi::FluidSetup{0.1, 0.2, 10, -1, {}});
+  EXPECT_NO_THROW(scene.check_all_used("fluid"));
+  EXPECT_NO_THROW(fsi::read_time(scene));
+  EXPECT_NO_THROW(scene.check_all_used("time"));
+  (void)fsi::coupling::read_coupling(scene.section("coupling"));
+  EXPECT_NO_THROW(scene.check_all_used("coupling"));
 }
 
 TEST(SceneSchema, ReferenceListsEveryModel) {
