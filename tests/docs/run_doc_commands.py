@@ -63,8 +63,6 @@ RUN = {
     "build/bin/fsi study studies/thick_beam.yaml --out runs/study_thick --jobs 2": ("append", "--set time.end=0.04 --quiet"),
     "/usr/bin/python3 tools/fsi_study.py plot runs/study_thick": None,
     "/usr/bin/python3 tools/fsi_study.py plot runs/study_thin": None,
-    "build/bin/fsi study studies/sdof_gamma.yaml --out runs/study_sdof [--jobs N]":
-        ("replace", "build/bin/fsi study studies/sdof_gamma.yaml --out runs/study_sdof --jobs 2 --set time.end=1 --quiet"),
     "/usr/bin/python3 tools/fsi_study.py run studies/sdof_gamma.yaml --out runs/study_sdof [--jobs N] [--fsi build/bin/fsi] [--quiet]":
         ("replace", "/usr/bin/python3 tools/fsi_study.py run studies/sdof_gamma.yaml --out runs/study_sdof --jobs 2 "
                     "--fsi build/bin/fsi --quiet --set time.end=1"),
