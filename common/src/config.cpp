@@ -48,10 +48,16 @@ void apply_override(YAML::Node root, const std::string& assignment, const std::s
 // A scene is a few hundred nodes; aliases (*a) of nested anchors (&a) let a few lines name
 // 2^40 of them, and a walk over the tree visits every one (fuzz/corpus/fuzz_scene/regress_alias_bomb).
 constexpr std::size_t kMaxSceneNodes = 100000;
+// An alias inside its own anchor (`a: &a [*a]`) makes the tree a cycle: a walk would recurse
+// until the stack overflows (fuzz/corpus/fuzz_scene/regress_alias_cycle). Scenes nest 4 deep.
+constexpr int kMaxSceneDepth = 64;
 
 // yaml-cpp keeps the last of two equal keys silently: refuse them, naming both lines.
 void check_duplicates(const YAML::Node& node, const std::string& path, const std::string& origin,
-                      std::size_t& visited) {
+                      std::size_t& visited, int depth = 0) {
+  if (depth > kMaxSceneDepth)
+    throw ConfigError(origin + ": '" + path + "' is nested more than " + std::to_string(kMaxSceneDepth) +
+                      " levels deep; is an anchor (&) used inside itself?");
   if (++visited > kMaxSceneNodes)
     throw ConfigError(origin + ": the scene has more than " + std::to_string(kMaxSceneNodes) +
                       " values (counting every use of an alias); is an anchor (&) used recursively?");
@@ -64,11 +70,11 @@ void check_duplicates(const YAML::Node& node, const std::string& path, const std
       if (!fresh)
         throw ConfigError(mark_string(origin, kv.first.Mark()) + ": duplicate key '" + full + "' (first at " +
                           mark_string(origin, it->second) + ")");
-      check_duplicates(kv.second, full, origin, visited);
+      check_duplicates(kv.second, full, origin, visited, depth + 1);
     }
   } else if (node.IsSequence()) {
     for (std::size_t i = 0; i < node.size(); ++i)
-      check_duplicates(node[i], path + "[" + std::to_string(i) + "]", origin, visited);
+      check_duplicates(node[i], path + "[" + std::to_string(i) + "]", origin, visited, depth + 1);
   }
 }
 

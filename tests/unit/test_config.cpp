@@ -110,6 +110,13 @@ TEST(Config, DuplicateKeyNamesBothLines) {
             std::string::npos);
 }
 
+TEST(Config, AliasInsideItsOwnAnchorIsRefusedNotAStackOverflow) {
+  // yaml-cpp turns `&a [1, *a]` into a cycle; a walk over it used to recurse until the stack overflowed.
+  const auto e = error_of([&] { fsi::Scene::parse("a1: &a1 [1, *a1]\ntime:\n  dt: 0.1\n", "c.yaml"); });
+  EXPECT_NE(e.find("c.yaml: 'a1[1][1]"), std::string::npos) << e;
+  EXPECT_NE(e.find("nested more than 64 levels deep; is an anchor (&) used inside itself?"), std::string::npos) << e;
+}
+
 TEST(Config, NotFiniteVectorSaysFinite) {
   auto scene = fsi::Scene::parse("fluid:\n  force: .nan\n", "f.yaml");
   const auto e = error_of([&] { fsi::read_vector2(scene.section("fluid"), "force"); });
