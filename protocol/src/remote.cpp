@@ -1,5 +1,7 @@
 #include "fsi/protocol/remote.hpp"
 
+#include "fsi/common/utf8.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -252,7 +254,7 @@ void load_call(ProtocolClient& client, int step, double time, const std::string&
 
 void stop_call(ProtocolClient& client, const std::string& reason) {
   fsi::v1::Request r;
-  r.mutable_stop()->set_reason(reason);
+  r.mutable_stop()->set_reason(fsi::valid_utf8(reason));
   client.set_timeout(std::chrono::seconds(2));
   client.call(r);
 }

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/utf8.hpp"
 #include "fsi/protocol/client.hpp"
 #include "fsi/protocol/remote.hpp"
 #include "fsi/transport/transport.hpp"
@@ -20,7 +21,7 @@ namespace {
 void set_error(fsi::v1::Reply& reply, fsi::v1::Error::Code code, const std::string& message) {
   reply.clear_body();
   reply.mutable_error()->set_code(code);
-  reply.mutable_error()->set_message(message);
+  reply.mutable_error()->set_message(fsi::valid_utf8(message));  // else the reply would not parse
 }
 
 // Checks a received vector: expected size and every entry finite.
@@ -71,7 +72,7 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
     const StepInfo info{request.accept_step().time(), dt,
                         static_cast<int>(request.accept_step().step()), 0};
     auto* out = reply.mutable_accept();
-    for (const auto& [k, v] : model->accept_step(info)) (*out->mutable_probes())[k] = v;
+    for (const auto& [k, v] : model->accept_step(info)) (*out->mutable_probes())[fsi::valid_utf8(k)] = v;
     for (const auto& [k, v] : model->timings()) (*out->mutable_timings())[k] = v;
   } else if (body == R::kSaveCheckpoint || body == R::kLoadCheckpoint) {
     if (!model->supports_checkpoint())
