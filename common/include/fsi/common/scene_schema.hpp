@@ -43,6 +43,18 @@ struct Condition {
   std::string fallback;  // the other key's value when it is absent
 };
 
+struct Key;
+
+// One value of a selector key (solid.model: sdof | fem) and the keys it brings. Declared before
+// Key and holding a vector of the then incomplete Key, which the standard allows (a vector of an
+// incomplete type must be complete before use); the other way round, clang rejects Key's inline
+// members.
+struct KeyVariant {
+  std::string value;    // e.g. "fem"
+  std::string meaning;  // one line for the reference
+  std::vector<Key> keys;
+};
+
 struct Key {
   std::string name;
   Type type = Type::Number;
@@ -60,7 +72,7 @@ struct Key {
   int size = 0;               // IntList, StringList: the number of entries (0 = any)
   // Sections whose keys depend on one of their keys (solid.model): that key and its variants.
   std::string selector;
-  struct Variant;
+  using Variant = KeyVariant;
   std::vector<Variant> variants;
 
   Key& req() { required = true; return *this; }
@@ -81,11 +93,6 @@ struct Key {
   Key& count(int n) { size = n; return *this; }
 };
 
-struct Key::Variant {
-  std::string value;    // e.g. "fem"
-  std::string meaning;  // one line for the reference
-  std::vector<Key> keys;
-};
 
 // The scene's top-level keys (scene, description, time, coupling, solid, fluid).
 const std::vector<Key>& scene_keys();
