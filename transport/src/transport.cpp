@@ -146,8 +146,16 @@ Client::~Client() {
 
 void Client::send(const std::string& payload, std::chrono::milliseconds timeout) {
   if (impl_->lost) throw PeerLostError(peer_name_ + " at " + endpoint_ + " was lost earlier");
+  // Poll until writable or the deadline: a signal (EINTR, e.g. the Ctrl-C that the coupler
+  // handles after this step) is not a timeout.
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
   zmq::pollitem_t item{impl_->socket.handle(), 0, ZMQ_POLLOUT, 0};
-  poll_items(&item, 1, timeout);
+  while (true) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    poll_items(&item, 1, std::max(left, std::chrono::milliseconds(0)));
+    if ((item.revents & ZMQ_POLLOUT) || left.count() <= 0) break;
+  }
   if (!(item.revents & ZMQ_POLLOUT))
     throw TimeoutError("cannot send to " + peer_name_ + " at " + endpoint_ + " within " +
                        std::to_string(timeout.count()) + " ms (not connected?)");
