@@ -517,18 +517,19 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", fsi::version_line("fsi"));
   auto* run_cmd = app.add_subcommand("run", "run one scene, starting only the processes it needs");
   RunOptions o;
-  o.out_dir = "runs/latest";
   run_cmd->add_option("scene", o.scene_path, "scene file (configs/*.yaml)")->required()->check(CLI::ExistingFile);
   run_cmd->add_option("--out", o.out_dir,
                       "output folder (summary.json, probes.csv, iterations.csv, logs, vtk/, checkpoints/); "
-                      "refused when not empty, unless --resume or --force");
+                      "default: runs/<scene file name without .yaml>; refused when not empty, unless --resume or "
+                      "--force");
   run_cmd->add_option("--set", o.overrides, "override any scene key: dotted.key=value (repeatable)");
   run_cmd->add_option("--solid-command", o.solid_command,
                       "start this external solid instead of solid_server (gets --bind and --port-file)");
   run_cmd->add_option("--fluid-command", o.fluid_command, "start this external fluid instead of fluid_server");
   run_cmd->add_option("--timeout", o.timeout,
                       "seconds the coupler waits for any single reply (a server that does not answer within it "
-                      "counts as failed; a dead one is noticed at once)");
+                      "counts as failed; a dead one is noticed at once)")
+      ->capture_default_str();
   run_cmd->add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
   run_cmd->add_flag("--force", o.force, "replace the results of an earlier run in --out");
   run_cmd->add_option("--recover", o.recover,
@@ -561,6 +562,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;  // command-line errors exit 1, like every failed run
+  }
+  if (run_cmd->parsed() && o.out_dir.empty()) {
+    o.out_dir = (fs::path("runs") / fs::path(o.scene_path).stem()).string();
+    fsi::logger("fsi")->info("results in {} (choose the folder with --out)", o.out_dir);
   }
   if (o.resume && o.force) {
     fsi::logger("fsi")->error("--resume and --force exclude each other");

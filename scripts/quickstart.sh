@@ -6,5 +6,5 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 cmake --preset release
 cmake --build --preset release -j "$(nproc)"
-build/bin/fsi run configs/sdof_model.yaml --out runs/sdof_model "$@"
+build/bin/fsi run configs/sdof_model.yaml --out runs/sdof_model --force "$@"   # --force: the quickstart may run again
 echo "results: runs/sdof_model/{summary.json,probes.csv,iterations.csv}"

@@ -102,6 +102,9 @@ def make_runner(args, study, out, fsi, jobs):
 
 def cmd_run(args):
     study = Study(args.study)
+    if not args.out:
+        args.out = os.path.join("runs", "study_" + Path(args.study).stem)
+        print(f"fsi_study: results in {args.out} (choose the folder with --out)", flush=True)
     out = Path(args.out).resolve()
     cli_sets = apply_sets(study, args.set)
     fsi = args.fsi or os.environ.get("FSI_BIN") or str(REPO / "build" / "bin" / "fsi")
@@ -195,7 +198,8 @@ def main(argv=None):
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="run (or resume) a study")
     r.add_argument("study")
-    r.add_argument("--out", default="runs/study", help="study folder (default: runs/study)")
+    r.add_argument("--out", default="", help="study folder (default: runs/study_<study file name without .yaml>); "
+                   "a folder of the same study is resumed")
     r.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores); with --executor dask and no --scheduler: the LocalCluster's workers")
     r.add_argument("--fsi", default="", help="the fsi executable (default: build/bin/fsi or $FSI_BIN)")
     r.add_argument("--quiet", action="store_true", help="no line per run")
@@ -224,6 +228,9 @@ def main(argv=None):
         return {"run": cmd_run, "plot": cmd_plot, "analyse": cmd_analyse}[args.cmd](args)
     except StudyError as e:
         print(f"fsi_study: {e}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:  # output piped into `head`: stop quietly, as other tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
 
 
