@@ -56,6 +56,10 @@ def main():
     rows = list(csv.DictReader(open(a.csv)))
     if not rows:
         sys.exit(f"periodic_stats: {a.csv}: no data rows")
+    # fsi run writes the fluid's probes as fluid.cd, fluid.lift, ...: accept the bare names too.
+    a.columns = [c if c in rows[0] or "fluid." + c not in rows[0] else "fluid." + c for c in a.columns]
+    if a.by_period and a.by_period not in rows[0] and "fluid." + a.by_period in rows[0]:
+        a.by_period = "fluid." + a.by_period
     missing = [c for c in a.columns + ([a.by_period] if a.by_period else []) if c not in rows[0]]
     if missing:
         sys.exit(f"periodic_stats: {a.csv}: no column {', '.join(missing)} (columns: {', '.join(rows[0])})")
@@ -73,16 +77,17 @@ def main():
               f"min {s['min']:.6g}  frequency {s['frequency']:.5g} Hz ({s['periods']} periods)"
               + (f"  St {s['strouhal']:.5f}" if a.strouhal_scale else ""))
     # The published frequency is the lift's (the drag oscillates at twice it, plus a part at it).
-    fcol = "lift" if "lift" in result else a.columns[0]
+    bare = {c: c[len("fluid."):] if c.startswith("fluid.") else c for c in a.columns}
+    fcol = next((c for c in a.columns if bare[c] == "lift"), a.columns[0])
     f0 = result[fcol]["frequency"]
     pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]  # rows of the window
     if a.reference:
         ref = REFERENCES[a.reference]
         print(f"against {a.reference}: midrange +/- amplitude [frequency of {fcol}]")
         for c in a.columns:
-            if c not in ref:
+            if bare[c] not in ref:
                 continue
-            m, amp, f = ref[c]
+            m, amp, f = ref[bare[c]]
             s = result[c]
             e = {"midrange_over_amplitude_percent": 100 * (s["midrange"] - m) / amp,
                  "midrange_percent": 100 * (s["midrange"] - m) / abs(m),
