@@ -28,8 +28,14 @@ def read(path):
         return f.read()
 
 
+# Sanitizer (Debug + ASan/UBSan) builds run the finite-element scenes 10-30x slower: scale the
+# bounds of the long waits with FSI_TEST_TIME_SCALE (default 1; the asan run uses 8).
+TIME_SCALE = float(os.environ.get("FSI_TEST_TIME_SCALE", "1"))
+
+
 def wait_rows(path, n, proc, timeout):
     """Waits until `path` has at least n data rows (fails if `proc` ends first)."""
+    timeout *= TIME_SCALE
     deadline = time.time() + timeout
     while time.time() < deadline:
         if rows(path) >= n:
@@ -103,6 +109,7 @@ def launch(env, scene, out, sets, extra=()):
 
 
 def finish(p, timeout):
+    timeout *= TIME_SCALE
     try:
         out, _ = p.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
