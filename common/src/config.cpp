@@ -7,19 +7,25 @@
 #include <sstream>
 
 namespace fsi {
-namespace {
 
-std::string mark_string(const std::string& origin, const YAML::Mark& mark) {
-  if (mark.is_null()) return origin + " (--set)";
-  return origin + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
-}
-
+namespace detail {
 std::vector<std::string> split_dotted(const std::string& key) {
   std::vector<std::string> parts;
   std::stringstream ss(key);
   std::string part;
   while (std::getline(ss, part, '.')) parts.push_back(part);
   return parts;
+}
+
+}  // namespace detail
+
+using detail::split_dotted;
+
+namespace {
+
+std::string mark_string(const std::string& origin, const YAML::Mark& mark) {
+  if (mark.is_null()) return origin + " (--set)";
+  return origin + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
 }
 
 void apply_override(YAML::Node root, const std::string& assignment, const std::string& origin) {

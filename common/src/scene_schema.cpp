@@ -156,14 +156,6 @@ bool strings(const YAML::Node& v) {
   return true;
 }
 
-std::vector<std::string> split_dotted(const std::string& key) {
-  std::vector<std::string> parts;
-  std::stringstream ss(key);
-  std::string part;
-  while (std::getline(ss, part, '.')) parts.push_back(part);
-  return parts;
-}
-
 YAML::Node find_key(const YAML::Node& map, const std::string& name) {
   if (map.IsMap())
     for (const auto& kv : map)
@@ -247,7 +239,7 @@ class Checker {
       value = find_key(map, c.key);
     } else {
       value.reset(scene_.root_node());
-      for (const auto& part : split_dotted(c.key)) {
+      for (const auto& part : fsi::detail::split_dotted(c.key)) {
         const YAML::Node next = find_key(value, part);
         value.reset(next);
         if (!value) break;

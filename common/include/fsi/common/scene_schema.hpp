@@ -16,6 +16,11 @@
 
 #include "fsi/common/config.hpp"
 
+namespace fsi::detail {
+// "a.b.c" -> {"a", "b", "c"} (config.cpp).
+std::vector<std::string> split_dotted(const std::string& key);
+}  // namespace fsi::detail
+
 namespace fsi::schema {
 
 enum class Type {
