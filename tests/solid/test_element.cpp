@@ -51,6 +51,61 @@ TEST_P(ElementTangent, MatchesFiniteDifferenceOfInternalForce) {
 
 INSTANTIATE_TEST_SUITE_P(Laws, ElementTangent, ::testing::Values("saint_venant_kirchhoff", "neo_hookean"));
 
+// The enhanced-strain element: its condensed tangent is the derivative of its force (the
+// enhanced parameters re-solved at every state).
+TEST_P(ElementTangent, EnhancedStrainCondensedTangentMatchesFiniteDifferences) {
+  const auto mat = make_material(GetParam(), ElasticConstants::from_youngs(1e3, 0.35));
+  const ElementCoords X = distorted_quad();
+  ElementVector u;
+  u << 0.0, 0.0, 0.15, 0.05, 0.1, 0.2, -0.05, 0.1;
+  const ElementState s = q4_eas_internal_force(X, u, *mat);
+  ASSERT_GT(s.min_det_F, 0);
+  EXPECT_LT((s.tangent - s.tangent.transpose()).norm(), 1e-10 * s.tangent.norm());
+  ElementMatrix fd;
+  const double h = 1e-7;
+  for (int j = 0; j < 8; ++j) {
+    ElementVector up = u, um = u;
+    up(j) += h;
+    um(j) -= h;
+    fd.col(j) = (q4_eas_internal_force(X, up, *mat, false).internal_force -
+                 q4_eas_internal_force(X, um, *mat, false).internal_force) / (2 * h);
+  }
+  EXPECT_LT((fd - s.tangent).norm(), 1e-6 * s.tangent.norm());
+  EXPECT_NEAR(s.internal_force(Eigen::seq(0, 7, 2)).sum(), 0.0, 1e-10 * s.internal_force.norm());
+  EXPECT_NEAR(s.internal_force(Eigen::seq(1, 7, 2)).sum(), 0.0, 1e-10 * s.internal_force.norm());
+}
+
+// Patch test: under a homogeneous deformation the enhanced strains vanish and the element is
+// the Q4 (the modes are orthogonal to constant stress on any parallelogram and, with the
+// centre-Jacobian scaling, on a distorted quad too).
+TEST(Q4Eas, HomogeneousDeformationGivesTheQ4Forces) {
+  const auto mat = make_material("neo_hookean", ElasticConstants::from_youngs(1e3, 0.3));
+  const ElementCoords X = distorted_quad();
+  Eigen::Matrix2d H;
+  H << 0.1, 0.05, -0.03, 0.08;
+  ElementVector u;
+  for (int a = 0; a < 4; ++a) u.segment<2>(2 * a) = H * X.row(a).transpose();
+  const ElementState q4 = q4_internal_force(X, u, *mat), eas = q4_eas_internal_force(X, u, *mat);
+  EXPECT_LT((q4.internal_force - eas.internal_force).norm(), 1e-10 * q4.internal_force.norm());
+}
+
+// Pure bending of one rectangular element (u_x = kappa x y, u_y = -kappa x^2 / 2): the Q4
+// locks (spurious shear), the enhanced element does not, so its bending stiffness is far lower.
+TEST(Q4Eas, NoShearLockingInBending) {
+  const auto mat = make_material("saint_venant_kirchhoff", ElasticConstants::from_youngs(1e3, 0.0));
+  ElementCoords X;
+  X << -1.0, -0.1, 1.0, -0.1, 1.0, 0.1, -1.0, 0.1;  // aspect ratio 10
+  const double kappa = 1e-6;
+  ElementVector u;
+  for (int a = 0; a < 4; ++a) u.segment<2>(2 * a) << kappa * X(a, 0) * X(a, 1), 0.0;
+  const double w_q4 = 0.5 * u.dot(q4_internal_force(X, u, *mat).internal_force);
+  const double w_eas = 0.5 * u.dot(q4_eas_internal_force(X, u, *mat).internal_force);
+  // Exact bending energy of the beam: E I kappa^2 L / 2 with I = h^3/12, L = 2, h = 0.2.
+  const double exact = 0.5 * 1e3 * (0.2 * 0.2 * 0.2 / 12) * kappa * kappa * 2;
+  EXPECT_NEAR(w_eas, exact, 1e-6 * exact);
+  EXPECT_GT(w_q4, 20 * exact);
+}
+
 TEST(Q4, MassAndBodyForceIntegrateTheArea) {
   const ElementCoords X = distorted_quad();
   // Shoelace area of the quad.

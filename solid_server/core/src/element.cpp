@@ -1,5 +1,6 @@
 #include "fsi/solid/element.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <cmath>
 #include <stdexcept>
@@ -110,6 +111,115 @@ ElementState q4_internal_force(const ElementCoords& X, const ElementVector& u, c
         out.tangent(2 * a + 1, 2 * b + 1) += dV * G(a, b);
       }
   }
+  return out;
+}
+
+ElementState q4_eas_internal_force(const ElementCoords& X, const ElementVector& u, const Material& material,
+                                   bool with_tangent) {
+  // Strain transformation at the centre: natural (covariant) strains -> Voigt [E11, E22, 2 E12].
+  const Eigen::Matrix2d J0 = X.transpose() * q4_shape_derivatives(0, 0);  // dX/dxi
+  const double det0 = J0.determinant();
+  const Eigen::Matrix2d K = J0.inverse();                                  // K(A, j) = dxi_A / dX_j
+  Eigen::Matrix3d T0;
+  T0 << K(0, 0) * K(0, 0), K(1, 0) * K(1, 0), K(0, 0) * K(1, 0),
+        K(0, 1) * K(0, 1), K(1, 1) * K(1, 1), K(0, 1) * K(1, 1),
+        2 * K(0, 0) * K(0, 1), 2 * K(1, 0) * K(1, 1), K(0, 0) * K(1, 1) + K(1, 0) * K(0, 1);
+  const Eigen::Map<const Eigen::Matrix<double, 2, 4>> U(u.data());
+  struct Point {
+    double dV;
+    Eigen::Matrix<double, 3, 8> B;
+    Eigen::Matrix<double, 3, 4> G;
+    Eigen::Vector3d Ec;
+    Eigen::Matrix<double, 4, 2> dNdX;
+    Matrix2 F;
+  };
+  std::array<Point, 4> pts;
+  ElementState out;
+  int g = 0;
+  for (const auto& [xi, eta, w] : gauss2()) {
+    Point& p = pts[static_cast<std::size_t>(g++)];
+    const double detJ = reference_gradients(X, xi, eta, p.dNdX);
+    out.min_det_jacobian = std::min(out.min_det_jacobian, detJ);
+    p.dV = w * detJ;
+    const Kinematics kc = Kinematics::from_displacement_gradient(U * p.dNdX);
+    p.F = kc.F;
+    out.min_det_F = std::min(out.min_det_F, kc.J);
+    p.Ec << kc.E(0, 0), kc.E(1, 1), 2 * kc.E(0, 1);
+    const Matrix2& F = p.F;
+    for (int a = 0; a < 4; ++a) {
+      const double n1 = p.dNdX(a, 0), n2 = p.dNdX(a, 1);
+      p.B(0, 2 * a) = F(0, 0) * n1;
+      p.B(0, 2 * a + 1) = F(1, 0) * n1;
+      p.B(1, 2 * a) = F(0, 1) * n2;
+      p.B(1, 2 * a + 1) = F(1, 1) * n2;
+      p.B(2, 2 * a) = F(0, 0) * n2 + F(0, 1) * n1;
+      p.B(2, 2 * a + 1) = F(1, 0) * n2 + F(1, 1) * n1;
+    }
+    Eigen::Matrix<double, 3, 4> M = Eigen::Matrix<double, 3, 4>::Zero();
+    M(0, 0) = xi;
+    M(1, 1) = eta;
+    M(2, 2) = xi;
+    M(2, 3) = eta;
+    p.G = (det0 / detJ) * T0 * M;
+  }
+  if (!(out.min_det_F > 0)) return out;  // the caller reports the inverted element
+  auto kinematics = [](const Point& p, const Eigen::Vector3d& e) {
+    Matrix2 E;
+    E << e(0), 0.5 * e(2), 0.5 * e(2), e(1);
+    return Kinematics::from_green_lagrange(E, p.F);
+  };
+  // Local Newton for the enhanced parameters: h(alpha) = int G^T S dV = 0.
+  Eigen::Vector4d alpha = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d Kaa;
+  for (int it = 0; it < 25; ++it) {
+    Eigen::Vector4d h = Eigen::Vector4d::Zero();
+    Kaa.setZero();
+    bool ok = true;
+    for (const Point& p : pts) {
+      const Kinematics k = kinematics(p, p.Ec + p.G * alpha);
+      if (!(k.J > 0)) {
+        ok = false;
+        break;
+      }
+      h.noalias() += p.dV * p.G.transpose() * material.stress(k);
+      Kaa.noalias() += p.dV * p.G.transpose() * material.tangent(k) * p.G;
+    }
+    if (!ok) {
+      out.min_det_F = std::min(out.min_det_F, -1.0);
+      return out;
+    }
+    const Eigen::Vector4d step = Kaa.ldlt().solve(h);
+    alpha -= step;
+    if (!alpha.allFinite()) {
+      out.min_det_F = std::min(out.min_det_F, -1.0);
+      return out;
+    }
+    if (step.cwiseAbs().maxCoeff() <= 1e-15 + 1e-13 * alpha.cwiseAbs().maxCoeff()) break;
+  }
+  // Force and condensed tangent at the converged alpha.
+  Eigen::Matrix<double, 8, 4> Kua = Eigen::Matrix<double, 8, 4>::Zero();
+  Kaa.setZero();
+  for (const Point& p : pts) {
+    const Kinematics k = kinematics(p, p.Ec + p.G * alpha);
+    out.min_det_F = std::min(out.min_det_F, k.J);
+    if (!(k.J > 0)) return out;
+    const Vector3 S = material.stress(k);
+    out.internal_force.noalias() += p.dV * p.B.transpose() * S;
+    if (!with_tangent) continue;
+    const Matrix3 D = material.tangent(k);
+    out.tangent.noalias() += p.dV * p.B.transpose() * D * p.B;
+    Kua.noalias() += p.dV * p.B.transpose() * D * p.G;
+    Kaa.noalias() += p.dV * p.G.transpose() * D * p.G;
+    Matrix2 Sm;
+    Sm << S(0), S(2), S(2), S(1);
+    const Eigen::Matrix4d Gm = p.dNdX * Sm * p.dNdX.transpose();
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) {
+        out.tangent(2 * a, 2 * b) += p.dV * Gm(a, b);
+        out.tangent(2 * a + 1, 2 * b + 1) += p.dV * Gm(a, b);
+      }
+  }
+  if (with_tangent) out.tangent.noalias() -= Kua * Kaa.ldlt().solve(Kua.transpose());
   return out;
 }
 

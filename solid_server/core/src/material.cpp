@@ -9,6 +9,23 @@ Kinematics Kinematics::from_deformation_gradient(const Matrix2& F) {
   return from_displacement_gradient(F - Matrix2::Identity());
 }
 
+Kinematics Kinematics::from_green_lagrange(const Matrix2& E, const Matrix2& F) {
+  Kinematics k;
+  k.F = F;
+  k.E = 0.5 * (E + E.transpose());
+  k.C = Matrix2::Identity() + 2.0 * k.E;
+  const double det_c_minus_1 = 2.0 * k.E.trace() + 4.0 * k.E.determinant();
+  const double det_c = 1.0 + det_c_minus_1;
+  if (!(det_c > 0)) {
+    k.J = -1;  // not a deformation: reported as inverted by the element
+    k.J_minus_1 = -2;
+    return k;
+  }
+  k.J = std::sqrt(det_c);
+  k.J_minus_1 = det_c_minus_1 / (k.J + 1.0);
+  return k;
+}
+
 Kinematics Kinematics::from_displacement_gradient(const Matrix2& H) {
   Kinematics k;
   k.F = Matrix2::Identity() + H;

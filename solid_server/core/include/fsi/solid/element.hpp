@@ -14,6 +14,9 @@ using ElementCoords = Eigen::Matrix<double, 4, 2>;   // reference coordinates X,
 using ElementVector = Eigen::Matrix<double, 8, 1>;
 using ElementMatrix = Eigen::Matrix<double, 8, 8>;
 
+// The quadrilateral's formulation: plain displacement Q4, or Q4 with enhanced assumed strains.
+enum class ElementKind { Q4, Q4Eas };
+
 // Shape functions and their derivatives on [-1, 1]^2 at (xi, eta).
 Eigen::Vector4d q4_shape(double xi, double eta);
 Eigen::Matrix<double, 4, 2> q4_shape_derivatives(double xi, double eta);  // dN/dxi, dN/deta
@@ -32,6 +35,14 @@ struct ElementState {
 // false only the force is computed.
 ElementState q4_internal_force(const ElementCoords& X, const ElementVector& u, const Material& material,
                                bool with_tangent = true);
+
+// The same with enhanced assumed strains (EAS, Q4E4): E = E(u) + G(xi) alpha with the four
+// modes [xi, eta, xi, eta] of Andelfinger & Ramm (1993) on the Green-Lagrange strain,
+// transformed with the Jacobian at the centre (Simo & Rifai 1990), and alpha condensed
+// out per element (a local Newton from alpha = 0 every call, so the element has no state).
+// Removes the Q4's shear locking in bending; the same nodes and dofs as the Q4.
+ElementState q4_eas_internal_force(const ElementCoords& X, const ElementVector& u, const Material& material,
+                                   bool with_tangent = true);
 
 // Consistent mass rho int N^T N dV (8x8).
 ElementMatrix q4_mass(const ElementCoords& X, double density);

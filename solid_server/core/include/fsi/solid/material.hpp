@@ -26,6 +26,10 @@ struct Kinematics {
   // From H = Grad u: E = (H + H^T + H^T H)/2 and J - 1 computed without the cancellation
   // of F^T F - I, so that tiny strains (1e-10) keep full relative accuracy.
   static Kinematics from_displacement_gradient(const Matrix2& H);
+  // From a Green-Lagrange strain that need not be compatible (enhanced assumed strain):
+  // C = I + 2 E, J = sqrt(det C), J - 1 without cancellation; F is left as given (the
+  // compatible one: the materials use E, C and J only).
+  static Kinematics from_green_lagrange(const Matrix2& E, const Matrix2& F);
 };
 
 // Lame parameters for plane strain from either (E, nu) or (mu, nu).
