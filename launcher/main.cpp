@@ -264,11 +264,55 @@ Child start_server(Server& s, const fs::path& bin, const std::string& bind, std:
 
 struct RunOptions {
   std::string scene_path, out_dir, solid_command, fluid_command, curve_keys;
+  std::string from;  // --from: a run folder (its newest checkpoint) or one checkpoint folder
   std::vector<std::string> overrides;
   double timeout = 600;
   bool resume = false, force = false;
   int recover = -1;  // -1: 3 when checkpoints are on, else 0
 };
+
+// --from PATH: the checkpoint folder (PATH itself when it holds a manifest.json, else the
+// newest complete one under PATH/checkpoints).
+fs::path fork_checkpoint(const std::string& from) {
+  const fs::path p(from);
+  if (fs::exists(p / "manifest.json")) return p;
+  const fs::path dir = p / "checkpoints";
+  if (!fs::is_directory(dir))
+    throw fsi::ConfigError(fmt::format("--from '{}': neither a checkpoint (no manifest.json) nor a run folder with "
+                                       "checkpoints/ (time.checkpoint_every > 0)",
+                                       from));
+  std::vector<fs::path> found;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_directory() && e.path().filename().string().rfind("step_", 0) == 0 && fs::exists(e.path() / "manifest.json"))
+      found.push_back(e.path());
+  if (found.empty()) throw fsi::ConfigError(fmt::format("--from '{}': no complete checkpoint in {}", from, dir.string()));
+  std::sort(found.begin(), found.end());
+  return found.back();
+}
+
+// Copies the checkpoint into OUT/checkpoints/ and writes OUT/forked_from.json: the coupler
+// then continues from it with the scene as given now (changed keys allowed and listed).
+void prepare_fork(const std::string& from, const fs::path& out) {
+  const fs::path ckpt = fork_checkpoint(from);
+  nlohmann::json manifest;
+  try {
+    std::ifstream in(ckpt / "manifest.json");
+    manifest = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw fsi::ConfigError(fmt::format("--from: {} does not parse ({})", (ckpt / "manifest.json").string(), e.what()));
+  }
+  fs::create_directories(out / "checkpoints");
+  fs::copy(ckpt, out / "checkpoints" / ckpt.filename(), fs::copy_options::recursive);
+  const nlohmann::json fork = {{"checkpoint", fs::absolute(ckpt).string()},
+                               {"step", manifest.value("step", 0)},
+                               {"time", manifest.value("time", 0.0)},
+                               {"iterations", manifest.value("iterations", 0)},
+                               {"scene_file", manifest.value("scene_file", std::string())},
+                               {"overrides", manifest.value("overrides", nlohmann::json::array())}};
+  std::ofstream(out / "forked_from.json") << fork.dump(2) << "\n";
+  fsi::logger("fsi")->info("forking from {} (step {}, t = {})", ckpt.string(), fork["step"].get<int>(),
+                           fork["time"].get<double>());
+}
 
 int run(const RunOptions& o) {
   auto log = fsi::logger("fsi");
@@ -297,6 +341,10 @@ int run(const RunOptions& o) {
   const fs::path out(o.out_dir), bin = self_dir();
   fsi::prepare_output_dir(out, o.resume ? fsi::OutputMode::Resume : o.force ? fsi::OutputMode::Force
                                                                            : fsi::OutputMode::Fresh);
+  if (!o.from.empty()) {
+    if (!coupled) throw fsi::ConfigError("--from: only coupled runs have checkpoints to start from");
+    prepare_fork(o.from, out);
+  }
   std::vector<std::string> sets;
   for (const auto& ov : o.overrides) sets.insert(sets.end(), {"--set", ov});
 
@@ -363,7 +411,7 @@ int run(const RunOptions& o) {
       servers.push_back(s);
     }
     int attempts = 0;
-    bool resume = o.resume;
+    bool resume = o.resume || !o.from.empty();
     while (true) {
       std::vector<std::string> argv{(bin / "coupler").string(), o.scene_path, "--solid", servers[0].endpoint, "--fluid",
                                     servers[1].endpoint, "--out", o.out_dir, "--timeout", fmt::format("{}", o.timeout),
@@ -532,6 +580,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
   run_cmd->add_flag("--force", o.force, "replace the results of an earlier run in --out");
+  run_cmd->add_option("--from", o.from,
+                      "start from a checkpoint of another run (its folder: the newest checkpoint; or one "
+                      "checkpoints/step_N folder) with this scene and --set changes, into a new --out (the "
+                      "original is not touched; summary.json lists the changed keys)");
   run_cmd->add_option("--recover", o.recover,
                       "restart a server that dies or stops answering up to N times, resuming from the last "
                       "checkpoint (default: 3 when time.checkpoint_every > 0, else 0)");
@@ -566,6 +618,10 @@ int main(int argc, char** argv) {
   if (run_cmd->parsed() && o.out_dir.empty()) {
     o.out_dir = (fs::path("runs") / fs::path(o.scene_path).stem()).string();
     fsi::logger("fsi")->info("results in {} (choose the folder with --out)", o.out_dir);
+  }
+  if (!o.from.empty() && o.resume) {
+    fsi::logger("fsi")->error("--from and --resume exclude each other (a forked run is resumed with --resume alone)");
+    return 1;
   }
   if (o.resume && o.force) {
     fsi::logger("fsi")->error("--resume and --force exclude each other");

@@ -68,6 +68,7 @@ class SdofSolid(fs.Solid):
         self.v_n = vector("initial_velocity")
         self.d = list(self.d_n)
         self.v = list(self.v_n)
+        self.gamma = interface_damping
         self.damping = interface_damping * self.measure
         return fs.Interface(coordinates=[0.0, 0.0], lumped_measure=[self.measure],
                             initial_displacement=self.d_n, initial_velocity=self.v_n)
@@ -81,6 +82,10 @@ class SdofSolid(fs.Solid):
             self.d[i] = rhs / lhs
             self.v[i] = (self.d[i] - self.d_n[i]) / dt
         return self.d, self.v
+
+    def set_interface_mass(self, matrix):
+        # Algorithm 2: M_fs = gamma_N1 * M_G with the coupler's M_G = H^T M_f H (1 x 1 here).
+        self.damping = self.gamma * float(matrix.toarray()[0, 0])
 
     def accept_step(self, step, time):
         self.d_n, self.v_n = list(self.d), list(self.v)

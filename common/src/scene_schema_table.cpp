@@ -87,8 +87,25 @@ std::vector<Key> coupling_keys() {
                   number("divergence_factor", "a residual this many times the step's first one = diverged")
                       .def("10000")
                       .gt(1),
+                  section_list("measures", "convergence measures per interface quantity (instead of tolerance)",
+                               {
+                                   choice("quantity", {"force", "traction", "displacement", "velocity"},
+                                          "force: the relaxed force update; traction: the physical traction "
+                                          "mismatch; displacement, velocity: change between iterations")
+                                       .req(),
+                                   choice("type", {"absolute", "relative", "residual-relative"},
+                                          "|r| < limit, |r| / |q| < limit, or |r_k| / |r_1| < limit")
+                                       .def("relative"),
+                                   number("limit", "the bound").req().gt(0),
+                                   boolean("strict", "not met in k_max iterations = the run diverged").def("false"),
+                               }),
+                  choice("combine", {"all", "any"}, "converged when all measures hold, or any").def("all"),
               })
           .req(),
+      choice("robin_mass", {"consistent", "solid"},
+             "interface mass of the gamma_N1 terms on the solid side: the fluid's H^T M_f H in its current "
+             "configuration (cancels exactly at convergence), or the solid's own int N^T N (earlier behaviour)")
+          .def("consistent"),
       number("force_limit", "an interface force above this = diverged").def("1e12").gt(0).in_unit("N"),
   };
 }
@@ -130,6 +147,9 @@ std::vector<Key> fem_solid_keys() {
                   number("shear_modulus", "mu").gt(0).group("modulus").in_unit("Pa"),
               })
           .req(),
+      choice("element", {"q4", "q4_eas"},
+             "bilinear Q4, or Q4 with enhanced assumed strains (no shear locking in bending; same nodes)")
+          .def("q4"),
       number("density", "rho_s, reference configuration").req().gt(0).in_unit("kg/m^3"),
       vector2("gravity", "body force per unit mass").def("[0, 0]").in_unit("m/s^2"),
       choice("analysis", {"static", "dynamic"}, "equilibrium every step, or dynamics").def("dynamic"),

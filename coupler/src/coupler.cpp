@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
@@ -52,12 +53,23 @@ Coupler::Coupler(SolidModel& solid, FluidModel& fluid, const Scene& scene, std::
 
 Eigen::VectorXd Coupler::robin_force(const Eigen::VectorXd& traction, const Eigen::VectorXd& velocity_integral,
                                      const Eigen::VectorXd& solid_velocity,
-                                     const Eigen::VectorXd& solid_displacement) const {
+                                     const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
   const double gamma = settings_.nitsche_penalty;
   if (settings_.algorithm == Algorithm::ImplicitSolidVelocity) return traction - gamma * velocity_integral;
   if (gamma == 0) return traction;
-  const Eigen::SparseMatrix<double> mg = interface_mass(solid_interface_, solid_displacement);
-  return traction + gamma * (mg * solid_velocity - velocity_integral);
+  return traction + gamma * (apply_nodal(algorithm1_mass(solid_displacement, mapped_mass), solid_velocity) - velocity_integral);
+}
+
+NodalMatrix Coupler::algorithm1_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
+  if (settings_.robin_mass == RobinMass::Consistent && mapped_mass.rows() > 0) return mapped_mass;
+  return nodal_interface_mass(solid_interface_, solid_displacement);  // the solid's polyline, current configuration
+}
+
+NodalMatrix Coupler::solid_damping_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
+  if (settings_.algorithm != Algorithm::ImplicitSolidVelocity) return NodalMatrix();
+  if (consistent_damping_ && mapped_mass.rows() > 0) return mapped_mass;
+  (void)solid_displacement;
+  return nodal_interface_mass(solid_interface_, Eigen::VectorXd());  // the solid's own, reference configuration
 }
 
 RunOutcome Coupler::run(RunReport& report) {
@@ -122,10 +134,26 @@ RunOutcome Coupler::run(RunReport& report) {
     }
     data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
                          {"max_gap", map_.max_gap()}};
+    consistent_damping_ = implicit && gamma > 0 && settings_.robin_mass == RobinMass::Consistent;
+    if (consistent_damping_ && !solid_.supports_interface_mass()) {
+      consistent_damping_ = false;
+      log->warn("the solid '{}' does not take the interface mass (supports_interface_mass): Algorithm 2's damping "
+                "uses its own int N^T N, and the gamma_N1 terms do not cancel exactly at convergence "
+                "(coupling.work_uncancelled in probes.csv)",
+                solid_.name());
+    }
     data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
                         {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
                         {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
-                        {"acceleration", to_string(settings_.acceleration)}};
+                        {"acceleration", to_string(settings_.acceleration)},
+                        {"robin_mass", to_string(settings_.robin_mass)}};
+    {
+      nlohmann::json measures = nlohmann::json::array();
+      for (const auto& m : settings_.measures)
+        measures.push_back({{"name", m.name()}, {"limit", m.limit}, {"strict", m.strict}});
+      data["coupling"]["measures"] = measures;
+      data["coupling"]["combine"] = settings_.combine_all ? "all" : "any";
+    }
     log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
               to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
               settings_.tolerance, ns, fluid_interface.nodes());
@@ -178,7 +206,27 @@ RunOutcome Coupler::run(RunReport& report) {
     // Work done across the interface, on each side: by the load the solid was actually
     // given, and by the fluid's traction on the fluid's interface motion. With the
     // transpose mapping they differ only by the partitioned scheme's lag and relaxation.
-    double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0;
+    double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0, work_uncancelled = 0;
+    // M_G = H^T M_f H of the fluid's last solve (empty when the fluid does not send M_f).
+    NodalMatrix mapped_mass;
+    bool warned_no_fluid_mass = false;
+    auto map_mass = [&](const FluidLoads& loads) {
+      if (loads.interface_mass.rows() == 0) {
+        if (!warned_no_fluid_mass && gamma > 0 && settings_.robin_mass == RobinMass::Consistent)
+          log->warn("the fluid '{}' does not send its interface mass M_f: the gamma_N1 terms use the solid's "
+                    "polyline int N^T N and cancel at convergence only where it equals H^T M_f H",
+                    fluid_.name());
+        warned_no_fluid_mass = true;
+        return NodalMatrix();
+      }
+      try {
+        return map_.mass_to_solid(loads.interface_mass);
+      } catch (const std::invalid_argument& e) {
+        throw Stop{"failed", fmt::format("fluid '{}': {}", fluid_.name(), e.what())};
+      }
+    };
+    // The velocity the accepted state ended with (the velocity measure's k = 1 reference).
+    Eigen::VectorXd v_s_prev = v_s;
     Eigen::VectorXd d_s_prev = d_s, d_f_prev = map_.to_fluid(d_s);
     InterfaceAccelerator accelerator(settings_);
     const nlohmann::json parameters = scene_to_json(scene_);
@@ -194,10 +242,29 @@ RunOutcome Coupler::run(RunReport& report) {
                                          skipped.empty() ? std::string() : " (" + skipped.front() + ")")};
       if (!restart) log->warn("no complete checkpoint yet: starting again from step 0");
     }
+    // A forked run (fsi run --from): OUT/forked_from.json names the checkpoint it started from;
+    // at that checkpoint the scene may differ (the changes are listed in summary.json), and
+    // its probes.csv and iterations.csv hold only the steps after it.
+    nlohmann::json fork;
+    if (std::filesystem::exists(out_dir_ / "forked_from.json")) {
+      try {
+        std::ifstream in(out_dir_ / "forked_from.json");
+        fork = nlohmann::json::parse(in);
+      } catch (const std::exception& e) {
+        throw Stop{"failed", fmt::format("{}: does not parse ({})", (out_dir_ / "forked_from.json").string(), e.what())};
+      }
+      data["forked_from"] = fork;
+    }
+    const int fork_step = fork.is_object() ? fork.value("step", 0) : 0;
+    const long fork_iterations = fork.is_object() ? fork.value("iterations", 0L) : 0L;
+    const bool at_fork = fork.is_object() && restart && restart->step == fork_step;
     if (restart) {
       const int step = restart->step;
       const auto diffs = parameter_differences(restart->manifest.value("parameters", nlohmann::json::object()), parameters);
-      if (!diffs.empty()) {
+      if (at_fork) {
+        data["forked_from"]["changed"] = diffs;
+        for (const auto& d : diffs) log->info("forked with {}", d);
+      } else if (!diffs.empty()) {
         std::string list;
         for (const auto& d : diffs) list += "\n  " + d;
         throw Stop{"failed", fmt::format("--resume: the scene differs from the one checkpoint {} was written with "
@@ -224,6 +291,27 @@ RunOutcome Coupler::run(RunReport& report) {
       force_nm1 = c.vector("force_nm1", 2 * ns);
       d_s_prev = c.vector("d_s_prev", 2 * ns);
       d_f_prev = c.vector("d_f_prev", d_f_prev.size());
+      if (c.has("v_s_prev")) v_s_prev = c.vector("v_s_prev", 2 * ns);
+      if (c.has("work_uncancelled")) work_uncancelled = c.real("work_uncancelled");
+      if (c.has("mapped_mass.values")) {
+        const Eigen::VectorXd rows = c.vector("mapped_mass.rows"), cols = c.vector("mapped_mass.cols"),
+                              values = c.vector("mapped_mass.values");
+        if (rows.size() != values.size() || cols.size() != values.size())
+          throw Stop{"failed", fmt::format("checkpoint {}: coupler part has a malformed mapped_mass", restart->dir.string())};
+        std::vector<Eigen::Triplet<double>> t;
+        for (Eigen::Index k = 0; k < values.size(); ++k) {
+          const auto r = static_cast<Eigen::Index>(rows[k]), col = static_cast<Eigen::Index>(cols[k]);
+          if (r < 0 || r >= ns || col < 0 || col >= ns)
+            throw Stop{"failed", fmt::format("checkpoint {}: coupler mapped_mass entry ({}, {}) outside {} nodes",
+                                             restart->dir.string(), r, col, ns)};
+          t.emplace_back(r, col, values[k]);
+        }
+        mapped_mass.resize(ns, ns);
+        mapped_mass.setFromTriplets(t.begin(), t.end());
+      } else if (implicit && gamma > 0) {
+        log->warn("checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
+                  "solid's own int N^T N", restart->dir.string(), step + 1);
+      }
       work_solid = c.real("work_solid");
       work_fluid = c.real("work_fluid");
       work_fluid_on_solid = c.real("work_fluid_on_solid");
@@ -239,7 +327,9 @@ RunOutcome Coupler::run(RunReport& report) {
         loads = fluid_.initial_loads(map_.to_fluid(d_s), map_.to_fluid(v_s));
       }
       Timer t(coupler_time);
-      force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s);
+      mapped_mass = map_mass(loads);
+      force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s,
+                             mapped_mass);
       force_nm1 = force_n;
       if (time.output_every > 0) {  // the initial state, t = 0
         write_output(StepInfo{0.0, time.dt, 0, 0},
@@ -255,13 +345,19 @@ RunOutcome Coupler::run(RunReport& report) {
     data["wall_time_earlier_segments"] = wall_before;
 
     // 3. Time loop.
-    const std::vector<std::string> iteration_columns{"step",        "time",         "iteration",       "residual",
-                                                     "force_norm",  "solid_newton", "fluid_iterations"};
-    ProbeTable probes = restart ? ProbeTable::resume(out_dir_ / "probes.csv", static_cast<std::size_t>(restart->step))
-                                : ProbeTable(out_dir_ / "probes.csv");
+    std::vector<std::string> iteration_columns{"step",          "time",          "iteration",         "residual",
+                                               "force_norm",    "solid_newton",  "fluid_iterations",  "traction_change",
+                                               "traction_norm", "displacement_change", "displacement_norm",
+                                               "velocity_change", "velocity_norm"};
+    for (const auto& m : settings_.measures) iteration_columns.push_back(m.name());
+    const bool resume_tables = restart && !at_fork;
+    ProbeTable probes = resume_tables ? ProbeTable::resume(out_dir_ / "probes.csv",
+                                                           static_cast<std::size_t>(restart->step - fork_step))
+                                      : ProbeTable(out_dir_ / "probes.csv");
     CsvWriter iterations =
-        restart ? CsvWriter::resume(out_dir_ / "iterations.csv", static_cast<std::size_t>(out.iterations), iteration_columns)
-                : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
+        resume_tables ? CsvWriter::resume(out_dir_ / "iterations.csv",
+                                          static_cast<std::size_t>(out.iterations - fork_iterations), iteration_columns)
+                      : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
     Progress progress("coupler", time.steps, out.steps);
     const double segment_start = now();
     auto save_checkpoint = [&](int n, double t_np1) {
@@ -278,6 +374,17 @@ RunOutcome Coupler::run(RunReport& report) {
       c.put("work_solid", work_solid);
       c.put("work_fluid", work_fluid);
       c.put("work_fluid_on_solid", work_fluid_on_solid);
+      c.put("work_uncancelled", work_uncancelled);
+      c.put("v_s_prev", v_s_prev);
+      if (mapped_mass.rows() > 0) {
+        std::vector<double> rows, cols, values;
+        for (int col = 0; col < mapped_mass.outerSize(); ++col)
+          for (NodalMatrix::InnerIterator it(mapped_mass, col); it; ++it)
+            rows.push_back(double(it.row())), cols.push_back(double(it.col())), values.push_back(it.value());
+        c.put("mapped_mass.rows", rows);
+        c.put("mapped_mass.cols", cols);
+        c.put("mapped_mass.values", values);
+      }
       c.put("iterations", static_cast<std::int64_t>(out.iterations));
       accelerator.save(c, "accelerator.");
       parts["coupler"] = c.serialize();
@@ -300,16 +407,32 @@ RunOutcome Coupler::run(RunReport& report) {
       Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * force_n - force_nm1)
                                                                                : force_n;
       double first_residual = 0, residual = 0, first_change = 0;
-      bool converged = settings_.tolerance == 0;
+      const std::size_t n_measures = settings_.measures.size();
+      bool converged = n_measures == 0;
+      std::vector<double> first_r(n_measures, 0.0), values(n_measures, 0.0);
       int k = 1;
       accelerator.begin_step();
       SolidStepResult s_last;
       FluidLoads loads_last;
-      Eigen::VectorXd force_applied, d_f_last;
+      Eigen::VectorXd force_applied, d_f_last, traction_last;
+      NodalMatrix damping_last, mass_last;
+      Eigen::VectorXd d_iter_prev = d_s_prev, v_iter_prev = v_s_prev;
       for (; k <= settings_.max_iterations; ++k) {
         if (interrupt_flag())
           throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
         const StepInfo info{t_np1, time.dt, n, k};
+        // Algorithm 2: the damping operator of this solve: H^T M_f H of the fluid's last solve
+        // (consistent), or the solid's own int N^T N.
+        NodalMatrix damping;
+        if (implicit && gamma > 0) {
+          if (consistent_damping_ && mapped_mass.rows() > 0) {
+            damping = mapped_mass;
+            Timer t(solid_time);
+            solid_.set_interface_mass(damping);
+          } else {
+            damping = nodal_interface_mass(solid_interface_, Eigen::VectorXd());
+          }
+        }
         SolidStepResult s;
         {
           Timer t(solid_time);
@@ -328,27 +451,65 @@ RunOutcome Coupler::run(RunReport& report) {
           Timer t(fluid_time);
           loads = fluid_.solve_step(info, d_f, v_f);
         }
-        Eigen::VectorXd relaxed;
+        Eigen::VectorXd relaxed, traction, traction_change;
+        NodalMatrix mass_k;
         {
           Timer t(coupler_time);
-          const Eigen::VectorXd f_star = robin_force(map_.to_solid(loads.traction_force),
-                                                     map_.to_solid(loads.velocity_integral), s.interface_velocity,
-                                                     s.interface_displacement);
+          mass_k = map_mass(loads);
+          const Eigen::VectorXd fs = map_.to_solid(loads.traction_force), fv = map_.to_solid(loads.velocity_integral);
+          const Eigen::VectorXd f_star = robin_force(fs, fv, s.interface_velocity, s.interface_displacement, mass_k);
+          // The physical traction H^T R = f_sigma - gamma (f_v - M_f v_s) (the fluid's reaction,
+          // without its penalty part), and its mismatch with what the solid felt: its load
+          // F^(k) minus its own Robin damping gamma C v_s.
+          const NodalMatrix m_phys =
+              mass_k.rows() > 0 ? mass_k : nodal_interface_mass(solid_interface_, s.interface_displacement);
+          traction = gamma > 0 ? Eigen::VectorXd(fs - gamma * (fv - apply_nodal(m_phys, s.interface_velocity))) : fs;
+          traction_change = traction + force;
+          if (damping.rows() > 0) traction_change -= gamma * apply_nodal(damping, s.interface_velocity);
           // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
           // (acceleration.hpp for Aitken and IQN-ILS).
           relaxed = accelerator.update(force, -f_star - force);
+          mapped_mass = mass_k;  // the next solid solve's damping (Algorithm 2)
         }
         if (!all_finite(relaxed))
           throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
         const double norm = relaxed.norm();
         const double change = (relaxed - force).norm();
         residual = change / std::max(norm, settings_.residual_floor);
-        iterations.row(std::vector<double>{double(n), t_np1, double(k), residual, norm, double(s.newton_iterations),
-                                           double(loads.nonlinear_iterations)});
+        // The interface quantities' changes and sizes (iterations.csv, convergence measures).
+        const double r_quantity[4] = {change, traction_change.norm(), (s.interface_displacement - d_iter_prev).norm(),
+                                      (s.interface_velocity - v_iter_prev).norm()};
+        const double q_quantity[4] = {norm, traction.norm(), s.interface_displacement.norm(),
+                                      s.interface_velocity.norm()};
+        d_iter_prev = s.interface_displacement;
+        v_iter_prev = s.interface_velocity;
+        bool all_met = true, any_met = false;
+        for (std::size_t i = 0; i < n_measures; ++i) {
+          const auto& m = settings_.measures[i];
+          const int q = static_cast<int>(m.quantity);
+          const double r = r_quantity[q];
+          if (k == 1) first_r[i] = r;
+          values[i] = m.type == MeasureType::Absolute   ? r
+                      : m.type == MeasureType::Relative ? r / std::max(q_quantity[q], settings_.residual_floor)
+                      : k == 1                          ? 1.0
+                                                        : r / std::max(first_r[i], settings_.residual_floor);
+          const bool met = values[i] < m.limit && !(m.type == MeasureType::ResidualRelative && k == 1 && r > 0);
+          all_met = all_met && met;
+          any_met = any_met || met;
+        }
+        std::vector<double> row_values{double(n),        t_np1,           double(k),        residual,
+                                       norm,             double(s.newton_iterations), double(loads.nonlinear_iterations),
+                                       r_quantity[1],    q_quantity[1],   r_quantity[2],    q_quantity[2],
+                                       r_quantity[3],    q_quantity[3]};
+        row_values.insert(row_values.end(), values.begin(), values.end());
+        iterations.row(row_values);
         force_applied = force;
         s_last = s;
         loads_last = loads;
         d_f_last = d_f;
+        traction_last = traction;
+        damping_last = damping;
+        mass_last = mass_k;
         force = relaxed;
         ++out.iterations;
         if (norm > settings_.force_limit)
@@ -356,8 +517,8 @@ RunOutcome Coupler::run(RunReport& report) {
                                              "iteration {} (loosely coupled instability?)",
                                              norm, settings_.force_limit, n, k)};
         if (k == 1) first_residual = residual, first_change = change;
-        if (settings_.tolerance > 0) {
-          if (residual < settings_.tolerance) {
+        if (n_measures > 0) {
+          if (settings_.combine_all ? all_met : any_met) {
             converged = true;
             break;
           }
@@ -371,11 +532,24 @@ RunOutcome Coupler::run(RunReport& report) {
                                                settings_.relaxation)};
         }
       }
+      if (!converged)
+        for (std::size_t i = 0; i < n_measures; ++i) {
+          const auto& m = settings_.measures[i];
+          if (m.strict && !(values[i] < m.limit))
+            throw Stop{"diverged", fmt::format("coupling measure {} (strict) not met in {} iterations at step {}: "
+                                               "{:.3e} >= {:.1e}",
+                                               m.name(), settings_.max_iterations, n, values[i], m.limit)};
+        }
       const int used = std::min(k, settings_.max_iterations);
-      if (!converged && settings_.stop_if_not_converged)
-        throw Stop{"diverged", fmt::format("coupling tolerance {:.1e} not reached in {} iterations at step {} "
-                                           "(last residual {:.3e}, first {:.3e})",
-                                           settings_.tolerance, settings_.max_iterations, n, residual, first_residual)};
+      if (!converged && settings_.stop_if_not_converged) {
+        std::string missed;
+        for (std::size_t i = 0; i < n_measures; ++i)
+          missed += fmt::format("{}{} {:.3e} (limit {:.1e})", missed.empty() ? "" : ", ", settings_.measures[i].name(),
+                                values[i], settings_.measures[i].limit);
+        throw Stop{"diverged", fmt::format("coupling not converged in {} iterations at step {}: {} (force residual "
+                                           "{:.3e}, first {:.3e})",
+                                           settings_.max_iterations, n, missed, residual, first_residual)};
+      }
       // Accept the step on both sides; record probes.
       const StepInfo accepted{t_np1, time.dt, n, used};
       std::map<std::string, double> row;
@@ -394,7 +568,34 @@ RunOutcome Coupler::run(RunReport& report) {
         // The same work evaluated on the solid's nodes through the transpose mapping:
         // identical up to round-off (the mapping neither creates nor destroys energy).
         work_fluid_on_solid -= map_.to_solid(loads_last.traction_force).dot(s_last.interface_displacement - d_s_prev);
+        // The interface power balance of the step (average over dt): the coupling load in the
+        // solid's equation (its force and its own Robin damping), the physical traction of the
+        // fluid, and the part of the gamma_N1 terms that would remain at exact convergence,
+        // gamma (H^T M_f H - C) v_s with both operators in the accepted configuration (zero
+        // when the solid's operator is the fluid's, robin_mass: consistent).
+        const Eigen::VectorXd dd = s_last.interface_displacement - d_s_prev;
+        const Eigen::VectorXd& v = s_last.interface_velocity;
+        Eigen::VectorXd load = force_applied;
+        if (damping_last.rows() > 0) load -= gamma * apply_nodal(damping_last, v);
+        double uncancelled = 0;
+        if (gamma > 0) {
+          const NodalMatrix m_phys =
+              mass_last.rows() > 0 ? mass_last : nodal_interface_mass(solid_interface_, s_last.interface_displacement);
+          const NodalMatrix c_cfg = implicit ? solid_damping_mass(s_last.interface_displacement, mass_last)
+                                             : algorithm1_mass(s_last.interface_displacement, mass_last);
+          uncancelled = gamma * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
+        }
+        work_uncancelled += uncancelled;
+        row["coupling.power_solid"] = load.dot(dd) / time.dt;
+        row["coupling.power_fluid"] = -traction_last.dot(dd) / time.dt;
+        row["coupling.power_uncancelled"] = uncancelled / time.dt;
+        row["coupling.work_uncancelled"] = work_uncancelled;
+        Eigen::Vector2d total = Eigen::Vector2d::Zero();
+        for (Eigen::Index i = 0; i < ns; ++i) total -= traction_last.segment<2>(2 * i);
+        row["coupling.solid_force_x"] = total(0);
+        row["coupling.solid_force_y"] = total(1);
         d_s_prev = s_last.interface_displacement;
+        v_s_prev = s_last.interface_velocity;
         d_f_prev = d_f_last;
       }
       row["coupling.iterations"] = used;

@@ -13,11 +13,13 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
   if (ns == 0 && nf == 0) {
     h_.resize(0, 0);
     ht_.resize(0, 0);
+    hs_.resize(0, 0);
+    hst_.resize(0, 0);
     return;
   }
   if (ns == 0 || nf == 0)
     throw std::invalid_argument(fmt::format("interface mismatch: the solid has {} interface nodes, the fluid {}", ns, nf));
-  std::vector<Eigen::Triplet<double>> t;
+  std::vector<Eigen::Triplet<double>> t, ts;
   for (Eigen::Index i = 0; i < nf; ++i) {
     const Eigen::Vector2d p = fluid.coordinates.row(i).transpose();
     double best = std::numeric_limits<double>::infinity();
@@ -45,10 +47,48 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
       t.emplace_back(2 * i + c, 2 * a + c, 1.0 - xi);
       if (xi > 0) t.emplace_back(2 * i + c, 2 * b + c, xi);
     }
+    ts.emplace_back(i, a, 1.0 - xi);
+    if (xi > 0) ts.emplace_back(i, b, xi);
   }
   h_.resize(2 * nf, 2 * ns);
   h_.setFromTriplets(t.begin(), t.end());
   ht_ = h_.transpose();
+  hs_.resize(nf, ns);
+  hs_.setFromTriplets(ts.begin(), ts.end());
+  hst_ = hs_.transpose();
+}
+
+NodalMatrix InterfaceMap::mass_to_solid(const NodalMatrix& fluid_mass) const {
+  if (fluid_mass.rows() != hs_.rows() || fluid_mass.cols() != hs_.rows())
+    throw std::invalid_argument(fmt::format("interface mass of the fluid is {} x {}, expected {} x {} (its interface nodes)",
+                                            fluid_mass.rows(), fluid_mass.cols(), hs_.rows(), hs_.rows()));
+  NodalMatrix m = hst_ * fluid_mass * hs_;
+  m.makeCompressed();
+  return m;
+}
+
+NodalMatrix nodal_interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement) {
+  const Eigen::Index n = solid.coordinates.rows();
+  std::vector<Eigen::Triplet<double>> t;
+  if (solid.segments.empty()) {
+    for (Eigen::Index i = 0; i < n; ++i) t.emplace_back(i, i, solid.lumped_measure[i]);
+  } else {
+    auto x = [&](int i) {
+      Eigen::Vector2d p = solid.coordinates.row(i).transpose();
+      if (displacement.size() == 2 * n) p += displacement.segment<2>(2 * i);
+      return p;
+    };
+    for (const auto& seg : solid.segments) {
+      const double len = (x(seg[1]) - x(seg[0])).norm();
+      t.emplace_back(seg[0], seg[0], len / 3);
+      t.emplace_back(seg[1], seg[1], len / 3);
+      t.emplace_back(seg[0], seg[1], len / 6);
+      t.emplace_back(seg[1], seg[0], len / 6);
+    }
+  }
+  NodalMatrix m(n, n);
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
 }
 
 Eigen::SparseMatrix<double> interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement) {

@@ -10,6 +10,18 @@ std::string to_string(Acceleration a) {
   return a == Acceleration::Constant ? "constant" : a == Acceleration::Aitken ? "aitken" : "iqn-ils";
 }
 
+std::string to_string(RobinMass m) { return m == RobinMass::Consistent ? "consistent" : "solid"; }
+
+std::string ConvergenceMeasure::name() const {
+  const char* q = quantity == MeasureQuantity::Force      ? "force"
+                  : quantity == MeasureQuantity::Traction ? "traction"
+                  : quantity == MeasureQuantity::Displacement ? "displacement"
+                                                              : "velocity";
+  const char* t = type == MeasureType::Absolute ? "absolute" : type == MeasureType::Relative ? "relative"
+                                                                                              : "residual_relative";
+  return std::string(q) + "_" + t;
+}
+
 CouplingSettings read_coupling(const ConfigSection& s) {
   CouplingSettings c;
   const int algorithm = s.get<int>("algorithm");
@@ -54,6 +66,37 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   c.stop_if_not_converged = it.get<bool>("stop_if_not_converged", true);
   c.divergence_factor = it.get<double>("divergence_factor", 1e4);
   if (!(c.divergence_factor > 1)) it.fail("divergence_factor", "must be > 1");
+  if (c.tolerance > 0) c.measures.push_back({MeasureQuantity::Force, MeasureType::Relative, c.tolerance, false});
+  for (const auto& m : it.list("measures")) {
+    if (it.has("tolerance") && c.tolerance > 0)
+      it.fail("measures", "give either 'tolerance' (the relative force change) or 'measures', not both");
+    ConvergenceMeasure cm;
+    const auto q = m.get<std::string>("quantity");
+    if (q == "force") cm.quantity = MeasureQuantity::Force;
+    else if (q == "traction") cm.quantity = MeasureQuantity::Traction;
+    else if (q == "displacement") cm.quantity = MeasureQuantity::Displacement;
+    else if (q == "velocity") cm.quantity = MeasureQuantity::Velocity;
+    else m.fail("quantity", "must be 'force', 'traction', 'displacement' or 'velocity', got '" + q + "'");
+    const auto t = m.get<std::string>("type", "relative");
+    if (t == "absolute") cm.type = MeasureType::Absolute;
+    else if (t == "relative") cm.type = MeasureType::Relative;
+    else if (t == "residual-relative") cm.type = MeasureType::ResidualRelative;
+    else m.fail("type", "must be 'absolute', 'relative' or 'residual-relative', got '" + t + "'");
+    cm.limit = m.get<double>("limit");
+    if (!(cm.limit > 0)) m.fail("limit", "must be > 0");
+    cm.strict = m.get<bool>("strict", false);
+    for (const auto& other : c.measures)
+      if (other.name() == cm.name()) m.fail("quantity", "measure '" + cm.name() + "' is given twice");
+    c.measures.push_back(cm);
+  }
+  const auto combine = it.get<std::string>("combine", "all");
+  if (combine == "all") c.combine_all = true;
+  else if (combine == "any") c.combine_all = false;
+  else it.fail("combine", "must be 'all' (every measure holds) or 'any'");
+  const auto robin = s.get<std::string>("robin_mass", "consistent");
+  if (robin == "consistent") c.robin_mass = RobinMass::Consistent;
+  else if (robin == "solid") c.robin_mass = RobinMass::Solid;
+  else s.fail("robin_mass", "must be 'consistent' (the fluid's H^T M_f H) or 'solid' (the solid's own int N^T N)");
   c.force_limit = s.get<double>("force_limit", 1e12);
   if (!(c.force_limit > 0)) s.fail("force_limit", "must be positive");
   return c;

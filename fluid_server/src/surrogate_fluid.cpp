@@ -29,6 +29,8 @@ FluidLoads SurrogateFluid::loads(const Eigen::Vector2d& v, const Eigen::Vector2d
   FluidLoads out;
   out.traction_force = -last_force_on_solid_;
   out.velocity_integral = measure_ * v;
+  out.interface_mass.resize(1, 1);
+  out.interface_mass.insert(0, 0) = measure_;
   out.nonlinear_iterations = 1;
   return out;
 }

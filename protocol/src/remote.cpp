@@ -23,6 +23,38 @@ void from_eigen(const Eigen::VectorXd& v, google::protobuf::RepeatedField<double
   for (Eigen::Index i = 0; i < v.size(); ++i) field->Set(static_cast<int>(i), v[i]);
 }
 
+void nodal_to_proto(const NodalMatrix& m, fsi::v1::NodalMatrix* out) {
+  out->Clear();
+  out->set_size(static_cast<unsigned>(m.rows()));
+  for (int col = 0; col < m.outerSize(); ++col)
+    for (NodalMatrix::InnerIterator it(m, col); it; ++it) {
+      out->add_rows(static_cast<unsigned>(it.row()));
+      out->add_cols(static_cast<unsigned>(it.col()));
+      out->add_values(it.value());
+    }
+}
+
+NodalMatrix nodal_from_proto(const fsi::v1::NodalMatrix& m, std::size_t n, const std::string& what) {
+  if (m.size() != n)
+    throw std::invalid_argument(fmt::format("{}: size {}, expected {} (interface nodes)", what, m.size(), n));
+  if (m.rows_size() != m.values_size() || m.cols_size() != m.values_size())
+    throw std::invalid_argument(fmt::format("{}: {} rows, {} cols and {} values (must be equal)", what, m.rows_size(),
+                                            m.cols_size(), m.values_size()));
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<std::size_t>(m.values_size()));
+  for (int k = 0; k < m.values_size(); ++k) {
+    if (m.rows(k) >= n || m.cols(k) >= n)
+      throw std::invalid_argument(fmt::format("{}: entry {} at ({}, {}) is outside {} x {}", what, k, m.rows(k),
+                                              m.cols(k), n, n));
+    if (!std::isfinite(m.values(k)))
+      throw std::invalid_argument(fmt::format("{}: entry {} at ({}, {}) is not finite", what, k, m.rows(k), m.cols(k)));
+    t.emplace_back(static_cast<int>(m.rows(k)), static_cast<int>(m.cols(k)), m.values(k));
+  }
+  NodalMatrix out(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  out.setFromTriplets(t.begin(), t.end());
+  return out;
+}
+
 InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
   InterfaceMeshData data;
   const int n = mesh.coordinates_size() / 2;
@@ -128,7 +160,7 @@ std::string session_name() {
 }
 
 std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* supports_damping,
-                  bool* supports_checkpoint, bool* supports_output) {
+                  bool* supports_checkpoint, bool* supports_output, bool* supports_interface_mass = nullptr) {
   fsi::v1::Request r;
   r.mutable_hello()->set_client_name("fsi coupler");
   r.mutable_hello()->set_session(session_name());
@@ -149,6 +181,7 @@ std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* su
     throw RemoteError(fsi::v1::Error::MALFORMED,
                       fmt::format("{} at {} sent a HelloReply without server_name", client.peer_name(), client.endpoint()));
   if (supports_damping) *supports_damping = reply.hello().supports_interface_damping();
+  if (supports_interface_mass) *supports_interface_mass = reply.hello().supports_interface_mass();
   *supports_checkpoint = reply.hello().supports_checkpoint();
   *supports_output = reply.hello().supports_output();
   return reply.hello().server_name();
@@ -263,7 +296,8 @@ void stop_call(ProtocolClient& client, const std::string& reason) {
 
 // ---------------------------------------------------------------------------- solid
 RemoteSolid::RemoteSolid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
-  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_, &supports_output_);
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_, &supports_output_,
+                       &supports_interface_mass_);
 }
 
 std::string RemoteSolid::save_checkpoint(int step, double time) { return save_call(*client_, step, time); }
@@ -287,7 +321,9 @@ SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::Vecto
   s->set_step(static_cast<unsigned>(info.step));
   s->set_iteration(static_cast<unsigned>(info.iteration));
   from_eigen(force, s->mutable_interface_force());
+  if (send_interface_mass_) nodal_to_proto(interface_mass_, s->mutable_interface_mass());
   const auto reply = step_call(*client_, r);
+  send_interface_mass_ = false;
   expect(reply.has_solid_step(), *client_, "solve_step");
   SolidStepResult out;
   out.interface_displacement = checked(reply.solid_step().interface_displacement(), interface_.nodes(), *client_,
@@ -332,6 +368,13 @@ FluidLoads loads_from(const fsi::v1::Reply& reply, std::size_t n, const Protocol
   out.traction_force = checked(reply.fluid_loads().traction_force(), n, client, "traction_force");
   out.velocity_integral = checked(reply.fluid_loads().velocity_integral(), n, client, "velocity_integral");
   out.nonlinear_iterations = static_cast<int>(reply.fluid_loads().nonlinear_iterations());
+  if (reply.fluid_loads().has_interface_mass()) {
+    try {
+      out.interface_mass = nodal_from_proto(reply.fluid_loads().interface_mass(), n, "interface_mass");
+    } catch (const std::invalid_argument& e) {
+      throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT, fmt::format("{} sent {}", client.peer_name(), e.what()));
+    }
+  }
   return out;
 }
 }  // namespace

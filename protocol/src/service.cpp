@@ -207,6 +207,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       h->set_server_name(server_name_);
       h->set_protocol_version(kProtocolVersion);
       h->set_supports_interface_damping(true);
+      h->set_supports_interface_mass(true);
       h->set_supports_output(true);
       h->set_supports_checkpoint(true);
       break;
@@ -245,6 +246,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       const Eigen::VectorXd force =
           checked_vector(s.interface_force(), 2 * interface_nodes_, "interface_force");
       StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
+      if (s.has_interface_mass()) model_->set_interface_mass(nodal_from_proto(s.interface_mass(), interface_nodes_, "interface_mass"));
       const SolidStepResult result = model_->solve_step(info, force);
       require_finite(result.interface_displacement, "solid step (displacement)");
       require_finite(result.interface_velocity, "solid step (velocity)");
@@ -278,6 +280,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     from_eigen(loads.traction_force, out->mutable_traction_force());
     from_eigen(loads.velocity_integral, out->mutable_velocity_integral());
     out->set_nonlinear_iterations(loads.nonlinear_iterations);
+    if (loads.interface_mass.rows() > 0) nodal_to_proto(loads.interface_mass, out->mutable_interface_mass());
   };
   switch (request.body_case()) {
     case R::kHello: {

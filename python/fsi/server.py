@@ -49,6 +49,14 @@ The methods (positional arguments, in this order):
     exception) for a state it cannot use.
 ``write_output(step, time) -> list of file names`` (optional)
     With it, ``supports_output = true``.
+``set_interface_mass(matrix)`` (optional, Algorithm 2)
+    With it, ``supports_interface_mass = true``: before a ``solve_step`` the coupler may send
+    the interface mass ``M_G = H^T M_f H`` (a ``NodalMatrix``: ``size``, ``rows``, ``cols``,
+    ``values``, ``toarray()``, ``matvec(v)`` for interleaved v), the fluid's own operator in
+    its current configuration mapped to your nodes. Use ``interface_damping * M_G`` as your
+    Robin damping from then on: the gamma_N1 terms then cancel exactly at convergence.
+    Without it, your own ``int N^T N`` is used and the coupler reports the part that does
+    not cancel (``coupling.work_uncancelled``).
 
 Class attributes: ``name`` (the HelloReply.server_name, default the class name),
 ``restart`` (how a repeated ``solve_step`` goes back to the accepted state: ``"auto"``
@@ -78,7 +86,7 @@ from fsi.v1 import coupling_pb2 as pb  # noqa: E402
 VERSION = 1
 CONFIGURE_ARGS = ("dt", "end_time", "interface_damping", "output_dir")
 
-__all__ = ["Solid", "Interface", "Server", "serve", "argument_parser", "InvalidArgument", "SolverFailed",
+__all__ = ["Solid", "Interface", "NodalMatrix", "Server", "serve", "argument_parser", "InvalidArgument", "SolverFailed",
            "Unsupported", "apply_overrides", "zeros", "VERSION", "pb"]
 
 
@@ -182,6 +190,42 @@ class Interface:
         mesh.initial_velocity.extend(float(x) for x in self.initial_velocity)
 
 
+class NodalMatrix:
+    """A sparse scalar matrix on the interface nodes (fsi.v1.NodalMatrix): it acts on the x
+    and y components alike. Duplicate (row, col) entries add up."""
+
+    def __init__(self, size, rows, cols, values):
+        self.size = int(size)
+        self.rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        self.cols = np.asarray(cols, dtype=np.int64).reshape(-1)
+        self.values = np.asarray(values, dtype=float).reshape(-1)
+        if not (self.rows.size == self.cols.size == self.values.size):
+            raise ValueError(f"NodalMatrix: {self.rows.size} rows, {self.cols.size} cols, {self.values.size} values")
+        if self.values.size and (self.rows.min() < 0 or self.cols.min() < 0 or self.rows.max() >= self.size
+                                 or self.cols.max() >= self.size):
+            raise ValueError(f"NodalMatrix: an index is outside {self.size} x {self.size}")
+        if not np.all(np.isfinite(self.values)):
+            raise ValueError("NodalMatrix: a value is not finite")
+
+    @classmethod
+    def from_proto(cls, m, size):
+        if m.size != size:
+            raise ValueError(f"interface_mass has size {m.size}, expected {size} (interface nodes)")
+        return cls(m.size, list(m.rows), list(m.cols), list(m.values))
+
+    def toarray(self):
+        a = np.zeros((self.size, self.size))
+        np.add.at(a, (self.rows, self.cols), self.values)
+        return a
+
+    def matvec(self, v):
+        """(M (x) I_2) v for an interleaved vector v of 2 values per node."""
+        v = np.asarray(v, dtype=float).reshape(-1, 2)
+        out = np.zeros_like(v)
+        np.add.at(out, self.rows, self.values[:, None] * v[self.cols])
+        return out.reshape(-1)
+
+
 class Solid:
     """Base class of an external solid (optional: any object with the same methods works).
     See the module documentation for the methods and attributes."""
@@ -223,6 +267,7 @@ class Server:
                                            self._configure_kwargs is None or "interface_damping" in self._configure_kwargs)
         self.supports_checkpoint = _implements(solid, "save") and _implements(solid, "load")
         self.supports_output = _implements(solid, "write_output")
+        self.supports_interface_mass = _implements(solid, "set_interface_mass")
         mode = getattr(solid, "restart", "auto")
         if mode in (None, False, "none"):
             mode = "none"
@@ -334,6 +379,7 @@ class Server:
             r.supports_interface_damping = bool(self.supports_interface_damping)
             r.supports_output = self.supports_output
             r.supports_checkpoint = self.supports_checkpoint
+            r.supports_interface_mass = self.supports_interface_mass
         elif body == "configure":
             self._configure(request.configure, reply)
         elif body == "get_interface":
@@ -429,6 +475,12 @@ class Server:
         if self._dirty:
             self._restore()  # a repeated solve_step: start again from the last accepted state
         self._dirty = True
+        if st.HasField("interface_mass") and self.supports_interface_mass:
+            try:
+                matrix = NodalMatrix.from_proto(st.interface_mass, self.interface.nodes)
+            except ValueError as e:
+                raise InvalidArgument(str(e)) from None
+            self.solid.set_interface_mass(matrix)
         result = self.solid.solve_step(int(st.step), float(st.time), float(st.dt), int(st.iteration), force)
         if not isinstance(result, (tuple, list)) or len(result) not in (2, 3):
             raise TypeError("solve_step must return (displacement, velocity) or (displacement, velocity, "

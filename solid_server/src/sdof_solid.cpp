@@ -21,9 +21,17 @@ void SdofSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   if (damping_ < 0) s.fail("damping", "must be >= 0");
   if (stiffness_ < 0) s.fail("stiffness", "must be >= 0");
   if (!(measure_ > 0)) s.fail("interface_measure", "must be positive");
-  interface_damping_ = setup.interface_damping * measure_;  // M_fs = gamma_N1 * M_G
+  gamma_ = setup.interface_damping;
+  interface_damping_ = gamma_ * measure_;  // M_fs = gamma_N1 * M_G (until the coupler gives its M_G)
   d_n_ = d_ = d0_;
   v_n_ = v_ = v0_;
+}
+
+void SdofSolid::set_interface_mass(const NodalMatrix& m) {
+  if (m.rows() != 1 || m.cols() != 1)
+    throw std::invalid_argument("sdof: interface mass must be 1 x 1 (one interface node), got " +
+                                std::to_string(m.rows()) + " x " + std::to_string(m.cols()));
+  interface_damping_ = gamma_ * m.coeff(0, 0);
 }
 
 InterfaceMeshData SdofSolid::interface() const {

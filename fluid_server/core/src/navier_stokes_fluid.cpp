@@ -441,6 +441,7 @@ FluidLoads NavierStokesFluid::initial_loads(const Eigen::VectorXd&, const Eigen:
   FluidLoads loads;
   loads.traction_force = solver_->interface_traction();
   loads.velocity_integral = solver_->interface_velocity_integral();
+  loads.interface_mass = solver_->interface_mass();
   return loads;
 }
 
@@ -463,6 +464,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   FluidLoads loads;
   loads.traction_force = solver_->interface_traction();
   loads.velocity_integral = solver_->interface_velocity_integral();
+  loads.interface_mass = solver_->interface_mass();
   loads.nonlinear_iterations = last_report_.iterations;
   factorisations_ += last_report_.factorisations;
   assembly_seconds_ += last_report_.assembly_seconds;

@@ -448,6 +448,23 @@ Eigen::VectorXd NavierStokesSolver::interface_velocity_integral() const {
   return fv;
 }
 
+Eigen::SparseMatrix<double> NavierStokesSolver::interface_mass() const {
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(4 * impl_->segments.size());
+  for (const auto& s : impl_->segments) {
+    const int na = interface_nodes_[static_cast<std::size_t>(s.iface_a)], nb = interface_nodes_[static_cast<std::size_t>(s.iface_b)];
+    const double length = (X_.row(nb) - X_.row(na)).norm();
+    t.emplace_back(s.iface_a, s.iface_a, length / 3.0);
+    t.emplace_back(s.iface_b, s.iface_b, length / 3.0);
+    t.emplace_back(s.iface_a, s.iface_b, length / 6.0);
+    t.emplace_back(s.iface_b, s.iface_a, length / 6.0);
+  }
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
+}
+
 Eigen::VectorXd NavierStokesSolver::interface_traction() const {
   const Eigen::Index ni = static_cast<Eigen::Index>(interface_nodes_.size());
   Eigen::VectorXd f(2 * ni);

@@ -454,6 +454,29 @@ Eigen::VectorXd TaylorHoodSolver::edge_integral(const Eigen::VectorXd& values) c
   return out;
 }
 
+Eigen::SparseMatrix<double> TaylorHoodSolver::interface_mass() const {
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(9 * impl_->edges.size());
+  for (const auto& ie : impl_->edges) {
+    Eigen::Matrix<double, 6, 2> x;
+    const auto nodes = mesh_.element_nodes6(ie.element);
+    for (int k = 0; k < 6; ++k) x.row(k) = X_.row(nodes(k));
+    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+    for (int g = 0; g < 4; ++g) {
+      const auto p = edge_point(x, ie.edge, kGaussX[g]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m(i, j) += kGaussW[g] * p.ds * p.N(kEdgeNodes[ie.edge][i]) * p.N(kEdgeNodes[ie.edge][j]);
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        t.emplace_back(ie.iface[static_cast<std::size_t>(i)], ie.iface[static_cast<std::size_t>(j)], m(i, j));
+  }
+  Eigen::SparseMatrix<double> out(n, n);
+  out.setFromTriplets(t.begin(), t.end());
+  return out;
+}
+
 Eigen::VectorXd TaylorHoodSolver::interface_velocity_integral() const {
   Eigen::VectorXd vf(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
   for (std::size_t i = 0; i < interface_nodes_.size(); ++i)

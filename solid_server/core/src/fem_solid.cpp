@@ -150,6 +150,9 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
     s.fail("clamp", e.what());
   }
   system_ = std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind);
+  const auto element = s.get<std::string>("element", "q4");
+  if (element == "q4_eas") system_->set_element(ElementKind::Q4Eas);
+  else if (element != "q4") s.fail("element", "must be 'q4' (bilinear) or 'q4_eas' (enhanced assumed strain), got '" + element + "'");
 
   // 6. Loads: gravity (force per reference volume rho_s g), dead edge tractions, point loads.
   const Eigen::Vector2d gravity = vec2(s, "gravity", Eigen::Vector2d::Zero());
@@ -241,10 +244,28 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   d_nm1_ = d_n_, v_nm1_ = v_n_;
   accepted_steps_ = 0;
   solved_ = false;
-  log->info("fem solid: {} nodes, {} Q4 cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
-            mesh_.num_nodes(), mesh_.num_cells(), system_->num_free(), material->name(), constants.mu,
+  log->info("fem solid: {} nodes, {} {} cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
+            mesh_.num_nodes(), mesh_.num_cells(), element, system_->num_free(), material->name(), constants.mu,
             constants.lambda, analysis, scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
             setup.interface_damping > 0 ? fmt::format(", interface damping {:.4g}", setup.interface_damping) : "");
+}
+
+void FemSolid::set_interface_mass(const NodalMatrix& m) {
+  if (!system_) throw SolverError("solid: set_interface_mass before configure");
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  if (m.rows() != n || m.cols() != n)
+    throw std::invalid_argument(fmt::format("solid: interface mass is {} x {}, expected {} x {} (interface nodes)",
+                                            m.rows(), m.cols(), n, n));
+  if (!(setup_.interface_damping > 0)) return;  // no damping (Algorithm 1 or gamma_N1 = 0)
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(2 * static_cast<std::size_t>(m.nonZeros()));
+  for (int col = 0; col < m.outerSize(); ++col)
+    for (NodalMatrix::InnerIterator it(m, col); it; ++it)
+      for (int c = 0; c < 2; ++c)
+        t.emplace_back(2 * interface_nodes_[static_cast<std::size_t>(it.row())] + c,
+                       2 * interface_nodes_[static_cast<std::size_t>(it.col())] + c,
+                       setup_.interface_damping * it.value());
+  system_->set_damping_entries(t);
 }
 
 Eigen::VectorXd FemSolid::external_force(const Eigen::VectorXd& interface_force) const {

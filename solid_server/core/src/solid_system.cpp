@@ -69,12 +69,18 @@ SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> 
     if (!(area2 > 0)) throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
   }
 
-  // Full pattern from the cell connectivity.
+  build_pattern({});
+}
+
+void SolidSystem::build_pattern(const std::vector<Eigen::Triplet<double>>& extra) {
+  const int n = num_dofs();
+  // Full pattern from the cell connectivity (and the extra entries).
   std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(64 * mesh_.cells.size());
+  trip.reserve(64 * mesh_.cells.size() + extra.size());
   for (const auto& cell : mesh_.cells)
     for (int a = 0; a < 8; ++a)
       for (int b = 0; b < 8; ++b) trip.emplace_back(2 * cell[a / 2] + a % 2, 2 * cell[b / 2] + b % 2, 0.0);
+  for (const auto& e : extra) trip.emplace_back(e.row(), e.col(), 0.0);
   pattern_.resize(n, n);
   pattern_.setFromTriplets(trip.begin(), trip.end());
   pattern_.makeCompressed();
@@ -112,6 +118,31 @@ SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> 
     for (int k = 0; k < 64; ++k) mass_.valuePtr()[cell_positions_[64 * c + k]] += Me(k / 8, k % 8);
   }
   damping_ = pattern_;
+  solver_ = SparseDirectSolver(solver_.kind());  // a new pattern: analysed again on the next solve
+}
+
+int SolidSystem::find_position(int row, int col) const {
+  const int* begin = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col];
+  const int* end = pattern_.innerIndexPtr() + pattern_.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(begin, end, row);
+  if (it == end || *it != row) return -1;
+  return static_cast<int>(it - pattern_.innerIndexPtr());
+}
+
+void SolidSystem::set_damping_entries(const std::vector<Eigen::Triplet<double>>& entries) {
+  for (const auto& e : entries)
+    if (e.row() < 0 || e.row() >= num_dofs() || e.col() < 0 || e.col() >= num_dofs())
+      throw std::invalid_argument("set_damping_entries: entry outside the system's dofs");
+  bool inside = true;
+  for (const auto& e : entries)
+    if (find_position(e.row(), e.col()) < 0) {
+      inside = false;
+      break;
+    }
+  if (!inside) build_pattern(entries);
+  SparseMatrix C = pattern_;
+  for (const auto& e : entries) C.valuePtr()[position(e.row(), e.col())] += e.value();
+  damping_ = std::move(C);
 }
 
 int SolidSystem::position(int row, int col) const {
@@ -176,10 +207,15 @@ Eigen::VectorXd SolidSystem::body_force(const std::function<Eigen::Vector2d(cons
   return f;
 }
 
+ElementState SolidSystem::cell_state(int c, const Eigen::VectorXd& d, bool with_tangent) const {
+  if (element_ == ElementKind::Q4Eas) return q4_eas_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
+  return q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
+}
+
 Eigen::VectorXd SolidSystem::internal_force(const Eigen::VectorXd& d) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
   for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const ElementState s = q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, false);
+    const ElementState s = cell_state(c, d, false);
     if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
     for (int a = 0; a < 4; ++a) f.segment<2>(2 * mesh_.cells[c][a]) += s.internal_force.segment<2>(2 * a);
   }
@@ -210,7 +246,7 @@ void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ex
   Eigen::VectorXd r = -f_ext;
   double* values = K.valuePtr();
   for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const ElementState s = q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, true);
+    const ElementState s = cell_state(c, d, true);
     if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
     for (int a = 0; a < 4; ++a) r.segment<2>(2 * mesh_.cells[c][a]) += s.internal_force.segment<2>(2 * a);
     const int* pos = &cell_positions_[64 * c];

@@ -11,6 +11,7 @@
 // everything the next step depends on; load_state() on a freshly configured model (same
 // scene) makes it continue exactly as the saved one would have, bit for bit.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <array>
 #include <cstdint>
@@ -38,6 +39,19 @@ class CheckpointUnsupported : public std::runtime_error {
 };
 [[noreturn]] inline void unsupported_checkpoint(const std::string& model) {
   throw CheckpointUnsupported("model '" + model + "' does not support checkpoints");
+}
+
+// A scalar matrix on interface nodes that acts on x and y alike (an interface mass
+// int N_i N_j dgamma); 0 x 0 = not given.
+using NodalMatrix = Eigen::SparseMatrix<double>;
+
+// (M (x) I_2) v for interleaved v = [x0, y0, x1, y1, ...].
+inline Eigen::VectorXd apply_nodal(const NodalMatrix& m, const Eigen::VectorXd& v) {
+  const Eigen::Map<const Eigen::Matrix<double, 2, Eigen::Dynamic>> V(v.data(), 2, v.size() / 2);
+  Eigen::VectorXd out(v.size());
+  Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>> O(out.data(), 2, v.size() / 2);
+  O = (m * V.transpose()).transpose();
+  return out;
 }
 
 struct InterfaceMeshData {
@@ -75,6 +89,12 @@ class SolidModel {
   virtual ~SolidModel() = default;
   virtual std::string name() const = 0;
   virtual bool supports_interface_damping() const { return true; }
+  // Algorithm 2 with a consistent damping: before a solve, the coupler may give the interface
+  // mass M_G = H^T M_f H (n x n, the fluid's current interface mapped to the solid's nodes);
+  // the model then uses M_fs = interface_damping * M_G until the next one. A model without
+  // it keeps its own int N^T N (the gamma_N1 terms then cancel only where the two agree).
+  virtual bool supports_interface_mass() const { return false; }
+  virtual void set_interface_mass(const NodalMatrix& /*m*/) {}
   // Reads this solver's section of the scene; must read every key it accepts.
   virtual void configure(const ConfigSection& section, const SolidSetup& setup) = 0;
   virtual InterfaceMeshData interface() const = 0;
@@ -119,6 +139,7 @@ struct FluidLoads {
   Eigen::VectorXd traction_force;     // f_sigma = int N^T sigma n dgamma (2n)
   Eigen::VectorXd velocity_integral;  // f_v = int N^T v_f dgamma (2n)
   int nonlinear_iterations = 0;
+  NodalMatrix interface_mass;         // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
 };
 
 class FluidModel {

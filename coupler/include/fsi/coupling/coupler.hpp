@@ -69,8 +69,17 @@ class Coupler {
   std::function<void(const RunOutcome&)> on_step;
 
  private:
+  // F* of the algorithm from the mapped loads; `mapped_mass` = H^T M_f H of the same fluid
+  // solve (empty when the fluid does not send M_f).
   Eigen::VectorXd robin_force(const Eigen::VectorXd& traction, const Eigen::VectorXd& velocity_integral,
-                              const Eigen::VectorXd& solid_velocity, const Eigen::VectorXd& solid_displacement) const;
+                              const Eigen::VectorXd& solid_velocity, const Eigen::VectorXd& solid_displacement,
+                              const NodalMatrix& mapped_mass) const;
+  // Algorithm 1's M_G in F* (robin_mass: consistent = mapped_mass; solid = the polyline mass
+  // in the current configuration).
+  NodalMatrix algorithm1_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const;
+  // The solid's damping operator in a configuration (Algorithm 2; empty for Algorithm 1).
+  NodalMatrix solid_damping_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const;
+  bool consistent_damping_ = false;  // Algorithm 2 and the solid takes H^T M_f H
   SolidModel& solid_;
   FluidModel& fluid_;
   const Scene& scene_;

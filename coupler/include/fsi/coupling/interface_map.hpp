@@ -20,15 +20,22 @@ class InterfaceMap {
   Eigen::VectorXd to_fluid(const Eigen::VectorXd& solid_values) const { return h_ * solid_values; }
   Eigen::VectorXd to_solid(const Eigen::VectorXd& fluid_forces) const { return ht_ * fluid_forces; }
   const Eigen::SparseMatrix<double>& matrix() const { return h_; }
+  // M_G = H^T M_f H for a scalar matrix on the fluid's interface nodes (e.g. its interface
+  // mass): the same operator seen from the solid's nodes, so that v_s . M_G v_s = v_f . M_f v_f
+  // for v_f = H v_s.
+  NodalMatrix mass_to_solid(const NodalMatrix& fluid_mass) const;
   double max_gap() const { return max_gap_; }  // largest fluid-node-to-solid distance
 
  private:
   Eigen::SparseMatrix<double> h_, ht_;
+  Eigen::SparseMatrix<double> hs_, hst_;  // the scalar (per node) H, n_f x n_s, and its transpose
   double max_gap_ = 0;
 };
 
 // M_G = int N^T N dgamma on the solid interface (2n x 2n, consistent, current
 // configuration = reference + displacement); diag(lumped_measure) for a point interface.
 Eigen::SparseMatrix<double> interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement);
+// The same as a scalar matrix on the solid's interface nodes (n x n).
+NodalMatrix nodal_interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement);
 
 }  // namespace fsi::coupling

@@ -3,6 +3,7 @@
 // velocity in the Robin term, 2 = implicit, adding M_fs = gamma_N1 M_G to the solid),
 // Nitsche parameters, relaxation beta, the force predictor and the iteration control.
 #include <string>
+#include <vector>
 
 #include "fsi/common/config.hpp"
 
@@ -14,6 +15,31 @@ enum class Predictor { Previous, Linear };
 // relaxation (Kuttler & Wall 2008) or interface quasi-Newton IQN-ILS (Degroote et al. 2009),
 // both beyond the paper and both starting each step with beta (acceleration.hpp).
 enum class Acceleration { Constant, Aitken, IqnIls };
+// The interface mass of the gamma_N1 terms on the solid's side: `consistent` = the fluid's
+// own M_f in the configuration of its last solve, mapped H^T M_f H (the terms cancel exactly
+// at convergence, any meshes, any deformation); `solid` = the solid's polyline int N^T N
+// (Algorithm 1: current configuration; Algorithm 2: the solid's reference one), which leaves
+// gamma_N1 (H^T M_f H - M_G) v_s in the converged solid equation (the earlier behaviour).
+enum class RobinMass { Consistent, Solid };
+
+// A convergence measure on one interface quantity (as preCICE's, per quantity):
+//   force        the relaxed force update F^(k+1) - F^(k) (it includes the gamma_N1 terms)
+//   traction     the physical traction: what the fluid's reaction H^T R exerts minus what the
+//                solid felt (its load and its Robin damping), in the solid's nodal forces
+//   displacement d_s^(k) - d_s^(k-1) (k = 1: against the last accepted step)
+//   velocity     v_s^(k) - v_s^(k-1)
+// and a test on the Euclidean norm |r| of that difference:
+//   absolute |r| < limit; relative |r| / |q| < limit (q the quantity itself);
+//   residual-relative |r_k| / |r_1| < limit (never at k = 1).
+enum class MeasureQuantity { Force, Traction, Displacement, Velocity };
+enum class MeasureType { Absolute, Relative, ResidualRelative };
+struct ConvergenceMeasure {
+  MeasureQuantity quantity = MeasureQuantity::Force;
+  MeasureType type = MeasureType::Relative;
+  double limit = 1e-4;
+  bool strict = false;  // not met in k_max iterations = the run diverged
+  std::string name() const;  // e.g. "traction_relative" (its iterations.csv column)
+};
 
 struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
@@ -32,6 +58,11 @@ struct CouplingSettings {
   double divergence_factor = 1e4;     // residual growth over the step's first residual
   double force_limit = 1e12;          // |F| above this = diverged (loosely coupled blow-up)
   double residual_floor = 1e-14;      // absolute floor of the residual's denominator
+  RobinMass robin_mass = RobinMass::Consistent;
+  // iterations.measures (or, without it, iterations.tolerance as {force, relative}); empty =
+  // always k_max iterations (the paper).
+  std::vector<ConvergenceMeasure> measures;
+  bool combine_all = true;            // iterations.combine: all measures must hold, or any
 };
 
 // Reads the `coupling` section (every key documented in configs/sdof_model.yaml).
@@ -39,5 +70,6 @@ CouplingSettings read_coupling(const ConfigSection& section);
 
 std::string to_string(Algorithm a);
 std::string to_string(Acceleration a);
+std::string to_string(RobinMass m);
 
 }  // namespace fsi::coupling

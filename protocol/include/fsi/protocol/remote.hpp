@@ -19,6 +19,8 @@ class RemoteSolid : public SolidModel {
   explicit RemoteSolid(std::unique_ptr<ProtocolClient> client);
   std::string name() const override { return server_name_; }
   bool supports_interface_damping() const override { return supports_damping_; }
+  bool supports_interface_mass() const override { return supports_interface_mass_; }
+  void set_interface_mass(const NodalMatrix& m) override { interface_mass_ = m, send_interface_mass_ = true; }
   void configure(const ConfigSection& section, const SolidSetup& setup) override;
   InterfaceMeshData interface() const override { return interface_; }
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
@@ -38,6 +40,9 @@ class RemoteSolid : public SolidModel {
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "solid server";
   bool supports_damping_ = false;
+  bool supports_interface_mass_ = false;
+  NodalMatrix interface_mass_;
+  bool send_interface_mass_ = false;  // a new M_G goes with the next SolveStep
   bool supports_checkpoint_ = false;
   bool supports_output_ = false;
   InterfaceMeshData interface_;
@@ -74,6 +79,10 @@ class RemoteFluid : public FluidModel {
 // Conversions between Eigen vectors and repeated double fields.
 Eigen::VectorXd to_eigen(const google::protobuf::RepeatedField<double>& field);
 void from_eigen(const Eigen::VectorXd& v, google::protobuf::RepeatedField<double>* field);
+// NodalMatrix <-> fsi.v1.NodalMatrix (coordinate format). nodal_from_proto checks the size
+// (n nodes), the indices and finiteness; std::invalid_argument names `what` and the entry.
+void nodal_to_proto(const NodalMatrix& m, fsi::v1::NodalMatrix* out);
+NodalMatrix nodal_from_proto(const fsi::v1::NodalMatrix& m, std::size_t n, const std::string& what);
 InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh);
 void interface_to_proto(const InterfaceMeshData& data, fsi::v1::InterfaceMesh* mesh);
 

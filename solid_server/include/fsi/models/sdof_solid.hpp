@@ -21,11 +21,14 @@ class SdofSolid : public SolidModel {
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   bool supports_checkpoint() const override { return true; }
+  bool supports_interface_mass() const override { return true; }
+  // M_fs = gamma_N1 * M_G with the coupler's M_G (1 x 1).
+  void set_interface_mass(const NodalMatrix& m) override;
   void save_state(StateArchive& state) override;
   void load_state(const StateArchive& state) override;
 
  private:
-  double mass_ = 1, damping_ = 0, stiffness_ = 0, measure_ = 1, interface_damping_ = 0;
+  double mass_ = 1, damping_ = 0, stiffness_ = 0, measure_ = 1, interface_damping_ = 0, gamma_ = 0;
   Eigen::Vector2d force_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d d_n_ = Eigen::Vector2d::Zero(), v_n_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d d_ = Eigen::Vector2d::Zero(), v_ = Eigen::Vector2d::Zero();

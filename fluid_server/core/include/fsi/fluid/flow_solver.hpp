@@ -5,6 +5,7 @@
 //   TaylorHoodSolver    - isoparametric Taylor-Hood P2/P1 (inf-sup stable; optional SUPG, grad-div)
 // Pure numerics: Eigen in, Eigen out; no configuration files, sockets or output.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <functional>
 #include <string>
@@ -125,6 +126,10 @@ class FlowSolver {
   // f_sigma = int N^T sigma n, f_v = int N^T v_f at the interface nodes (current configuration).
   virtual Eigen::VectorXd interface_traction() const = 0;
   virtual Eigen::VectorXd interface_velocity_integral() const = 0;
+  // M_f = int N_i N_j dgamma over the interface in the configuration of the last solve, with
+  // the quadrature of the Nitsche terms (a scalar matrix on the interface nodes): f_v = M_f v_f
+  // and the penalty part of f_sigma is gamma_N1 M_f (v_f - v_s).
+  virtual Eigen::SparseMatrix<double> interface_mass() const = 0;
   virtual double pressure_at(const Eigen::Vector2d& point) const = 0;  // NaN outside the mesh
   virtual Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const = 0;
 };

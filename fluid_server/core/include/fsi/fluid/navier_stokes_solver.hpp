@@ -73,6 +73,7 @@ class NavierStokesSolver : public FlowSolver {
   // term: reaction + gamma_N1 int N^T (v_f - v_s); f_v = int N^T v_f. Current configuration.
   Eigen::VectorXd interface_traction() const override;
   Eigen::VectorXd interface_velocity_integral() const override;
+  Eigen::SparseMatrix<double> interface_mass() const override;
   double pressure_at(const Eigen::Vector2d& point) const override;  // NaN outside the mesh
   Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const override;
 

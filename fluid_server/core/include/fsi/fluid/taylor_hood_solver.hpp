@@ -59,6 +59,7 @@ class TaylorHoodSolver : public FlowSolver {
   const IndexMatrix2& interface_segments() const override { return interface_segments_; }
   Eigen::VectorXd interface_traction() const override;
   Eigen::VectorXd interface_velocity_integral() const override;
+  Eigen::SparseMatrix<double> interface_mass() const override;
   double pressure_at(const Eigen::Vector2d& point) const override;
   Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const override;
 

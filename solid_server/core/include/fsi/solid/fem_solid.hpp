@@ -48,6 +48,10 @@ class FemSolid : public fsi::SolidModel {
   std::vector<std::string> write_output(const StepInfo& info) override;
   // Checkpoints: the accepted state and the integrator's history (solid.*).
   bool supports_checkpoint() const override { return true; }
+  bool supports_interface_mass() const override { return true; }
+  // Algorithm 2: M_fs = interface_damping * (M_G (x) I_2) on the interface dofs, replacing the
+  // reference-configuration int N^T N of configure().
+  void set_interface_mass(const NodalMatrix& m) override;
   void save_state(StateArchive& state) override;
   void load_state(const StateArchive& state) override;
 

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/solid/element.hpp"
 #include "fsi/solid/material.hpp"
 #include "fsi/solid/mesh.hpp"
 
@@ -87,9 +88,16 @@ class SolidSystem {
   const std::vector<char>& fixed() const { return fixed_; }
 
   const SparseMatrix& mass() const { return mass_; }  // full, consistent
+  // Q4 (default) or Q4 with enhanced assumed strains, for every cell.
+  void set_element(ElementKind kind) { element_ = kind; }
+  ElementKind element() const { return element_; }
   // weight * int N^T N ds on the given edges (reference configuration), full size.
   SparseMatrix boundary_mass(const std::vector<std::array<int, 2>>& edges, double weight) const;
   void set_damping(SparseMatrix damping);  // C in R(d); pattern must fit the mesh's
+  // C from entries (global dofs; duplicates add up). Entries outside the mesh's pattern (an
+  // interface mass that couples nodes of different cells) extend the pattern once; the
+  // linear solver then analyses the new pattern.
+  void set_damping_entries(const std::vector<Eigen::Triplet<double>>& entries);
   const SparseMatrix& damping() const { return damping_; }
 
   Eigen::VectorXd body_force(const Eigen::Vector2d& force_per_volume) const;
@@ -119,7 +127,11 @@ class SolidSystem {
   Eigen::Matrix<double, 8, 1> cell_values(int cell, const Eigen::VectorXd& d) const;
 
  private:
-  int position(int row, int col) const;  // value index in the full pattern
+  int position(int row, int col) const;  // value index in the full pattern (throws outside it)
+  int find_position(int row, int col) const;  // -1 outside the pattern
+  // (Re)builds pattern_, the reduced pattern, the value maps and mass_ with the cells' entries
+  // plus `extra` (global dof pairs).
+  void build_pattern(const std::vector<Eigen::Triplet<double>>& extra);
   SolidMesh mesh_;
   std::shared_ptr<const Material> material_;
   double density_;
@@ -132,6 +144,8 @@ class SolidSystem {
   std::vector<int> full_to_reduced_;  // value index map, -1 for fixed rows/cols
   std::vector<int> cell_positions_;   // 64 per cell: full value index
   SparseDirectSolver solver_;
+  ElementKind element_ = ElementKind::Q4;
+  ElementState cell_state(int cell, const Eigen::VectorXd& d, bool with_tangent) const;
 };
 
 }  // namespace fsi::solid
