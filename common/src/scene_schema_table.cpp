@@ -71,6 +71,10 @@ std::vector<Key> coupling_keys() {
       section("iqn", "IQN-ILS options",
               {
                   integer("reuse_steps", "secant pairs are kept from the last N steps").def("8").ge(0),
+                  choice("new_directions", {"full", "relaxed"},
+                         "the residual outside the secant columns' span: a full step (classic IQN-ILS) or beta "
+                         "times it (robust under strong added mass)")
+                      .def("full"),
                   number("filter", "drop a column whose orthogonal remainder is below filter x its norm")
                       .def("0.001")
                       .gt(0)
@@ -264,6 +268,10 @@ std::vector<Key> fem_fluid_keys() {
               {
                   string_list("groups", "boundary group(s) of the interface").def("[]"),
                   number("penalty", "gamma_N1 of standalone runs (coupled: coupling.gamma_n1)").def("0").ge(0),
+                  choice("penalty_geometry", {"current", "step_start"},
+                         "the Nitsche penalty term (and f_v, M_f) on the interface of this solve, or of the last "
+                         "accepted step (M_G constant within a step: robust converged Algorithm 2 at large gamma_N1)")
+                      .def("current"),
                   number("symmetry", "gamma_N2 of standalone runs (coupled: coupling.gamma_n2)")
                       .def("-1")
                       .values({"1", "-1"}),

@@ -20,6 +20,8 @@ struct Run {
   fsi::coupling::RunOutcome outcome;
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;
+  std::vector<std::string> iteration_columns;
+  std::vector<std::vector<double>> iteration_rows;
   std::vector<double> column(const std::string& name) const {
     const auto it = std::find(columns.begin(), columns.end(), name);
     EXPECT_NE(it, columns.end()) << name;
@@ -53,6 +55,17 @@ Run run_scene(const std::vector<std::string>& overrides) {
     std::vector<double> row;
     for (std::string c; std::getline(ss, c, ',');) row.push_back(std::stod(c));
     run.rows.push_back(row);
+  }
+  std::ifstream it(out / "iterations.csv");
+  if (std::getline(it, line)) {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) run.iteration_columns.push_back(c);
+  }
+  while (std::getline(it, line)) {
+    std::stringstream ss(line);
+    std::vector<double> row;
+    for (std::string c; std::getline(ss, c, ',');) row.push_back(std::stod(c));
+    run.iteration_rows.push_back(row);
   }
   fs::remove_all(out);
   return run;
@@ -200,6 +213,54 @@ TEST(Outcome, OutOfRangeRelaxationIsRejected) {
   const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=2.5"});
   EXPECT_EQ(run.outcome.status, "failed");
   EXPECT_NE(run.outcome.reason.find("must be in (0, 2) with Algorithm 1"), std::string::npos) << run.outcome.reason;
+}
+
+// Convergence measured on physical quantities: the added-mass model with Aitken, converged on
+// the interface displacement change; every iteration's measure value is in iterations.csv and
+// the last one of each step is below its limit.
+TEST(Measures, ConvergedOnTheDisplacementChangeWithItsValuesInIterationsCsv) {
+  const auto run = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0", "coupling.relaxation=0.5",
+                              "coupling.acceleration=aitken", "coupling.iterations.max=50",
+                              "coupling.iterations.measures=[{quantity: displacement, type: absolute, limit: 1.0e-12}, "
+                              "{quantity: traction, type: relative, limit: 1.0e-9}]",
+                              "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10",
+                              "fluid.force=1", "time.end=1"});
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  const auto& cols = run.iteration_columns;
+  const auto d = std::find(cols.begin(), cols.end(), "displacement_absolute") - cols.begin();
+  const auto t = std::find(cols.begin(), cols.end(), "traction_relative") - cols.begin();
+  const auto step = std::find(cols.begin(), cols.end(), "step") - cols.begin();
+  ASSERT_LT(d, static_cast<long>(cols.size()));
+  ASSERT_LT(t, static_cast<long>(cols.size()));
+  ASSERT_EQ(run.rows.size(), 50u);
+  int steps_checked = 0;
+  for (std::size_t i = 0; i < run.iteration_rows.size(); ++i) {
+    const bool last_of_step = i + 1 == run.iteration_rows.size() ||
+                              run.iteration_rows[i + 1][static_cast<std::size_t>(step)] !=
+                                  run.iteration_rows[i][static_cast<std::size_t>(step)];
+    if (!last_of_step) continue;
+    EXPECT_LT(run.iteration_rows[i][static_cast<std::size_t>(d)], 1e-12);
+    EXPECT_LT(run.iteration_rows[i][static_cast<std::size_t>(t)], 1e-9);
+    ++steps_checked;
+  }
+  EXPECT_EQ(steps_checked, 50);
+}
+
+TEST(Measures, AStrictMeasureNotMetEndsTheRunNamingIt) {
+  const auto run = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0", "coupling.relaxation=0.1",
+                              "coupling.iterations.max=3", "coupling.iterations.stop_if_not_converged=false",
+                              "coupling.iterations.measures=[{quantity: velocity, type: residual-relative, "
+                              "limit: 1.0e-10, strict: true}]",
+                              "fluid.added_mass=10", "fluid.force=1", "time.end=1"});
+  EXPECT_EQ(run.outcome.status, "diverged");
+  EXPECT_NE(run.outcome.reason.find("velocity_residual_relative (strict)"), std::string::npos) << run.outcome.reason;
+}
+
+TEST(Measures, ToleranceAndMeasuresTogetherAreRefused) {
+  const auto run = run_scene({"coupling.iterations.tolerance=1e-6",
+                              "coupling.iterations.measures=[{quantity: force, limit: 1.0e-6}]"});
+  EXPECT_EQ(run.outcome.status, "failed");
+  EXPECT_NE(run.outcome.reason.find("either 'tolerance'"), std::string::npos) << run.outcome.reason;
 }
 
 TEST(Outcome, Algorithm2AcceptsRelaxationAboveOne) {

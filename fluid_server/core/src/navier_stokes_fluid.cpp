@@ -238,6 +238,11 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
                 "using the coupler's", penalty, symmetry, setup.nitsche_penalty, setup.nitsche_symmetry);
     }
     if (params.nitsche_penalty < 0) iface->fail("penalty", "gamma_N1 must be >= 0");
+    const auto geometry = iface->get<std::string>("penalty_geometry", "current");
+    if (geometry == "step_start") params.penalty_on_step_start = true;
+    else if (geometry != "current")
+      iface->fail("penalty_geometry", "must be 'current' (the interface of this solve) or 'step_start' (of the last "
+                                      "accepted step), got '" + geometry + "'");
     if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
   }
 

@@ -344,24 +344,30 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
       mass(s.local_a, s.local_a) = mass(s.local_b, s.local_b) = length / 3.0;
       mass(s.local_a, s.local_b) = mass(s.local_b, s.local_a) = length / 6.0;
       integral(s.local_a) = integral(s.local_b) = length / 2.0;
+      // The penalty term's mass: on this interface, or on the last accepted step's.
+      Eigen::Matrix3d penalty_mass = mass;
+      if (params_.penalty_on_step_start) {
+        const double ln = (X_n_.row(mesh_.triangles(s.element, s.local_b)) - X_n_.row(mesh_.triangles(s.element, s.local_a))).norm();
+        penalty_mass = mass * (ln / length);
+      }
       const Eigen::Vector3d gn = geo.grad * normal;  // grad N_i . n
       Eigen::Matrix<double, 3, 2> vs = Eigen::Matrix<double, 3, 2>::Zero();
       vs.row(s.local_a) = interface_velocity_.segment<2>(2 * s.iface_a).transpose();
       vs.row(s.local_b) = interface_velocity_.segment<2>(2 * s.iface_b).transpose();
-      const Eigen::Matrix<double, 3, 2> mass_vs = mass * vs;
+      const Eigen::Matrix<double, 3, 2> mass_vs = mass * vs, penalty_vs = penalty_mass * vs;
       const Eigen::RowVector2d int_vs = integral.transpose() * vs;
       Eigen::Matrix<double, 9, 9> local = Eigen::Matrix<double, 9, 9>::Zero();
       Eigen::Matrix<double, 9, 1> local_rhs = Eigen::Matrix<double, 9, 1>::Zero();
       for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
-          const double vel = g1 * mass(i, j) - mu * integral(i) * gn(j) - g2 * mu * gn(i) * integral(j);
+          const double vel = g1 * penalty_mass(i, j) - mu * integral(i) * gn(j) - g2 * mu * gn(i) * integral(j);
           for (int c = 0; c < 2; ++c) {
             local(3 * i + c, 3 * j + c) += vel;
             local(3 * i + c, 3 * j + 2) += normal(c) * mass(i, j);
             local(3 * i + 2, 3 * j + c) += g2 * normal(c) * mass(i, j);
           }
         }
-        for (int c = 0; c < 2; ++c) local_rhs(3 * i + c) = g1 * mass_vs(i, c) - g2 * mu * gn(i) * int_vs(c);
+        for (int c = 0; c < 2; ++c) local_rhs(3 * i + c) = g1 * penalty_vs(i, c) - g2 * mu * gn(i) * int_vs(c);
         local_rhs(3 * i + 2) = g2 * mass_vs.row(i).dot(normal.transpose());
       }
       for (int j = 0; j < 3; ++j) {
@@ -438,9 +444,10 @@ Eigen::Vector2d NavierStokesSolver::force(const std::vector<std::string>& groups
 
 Eigen::VectorXd NavierStokesSolver::interface_velocity_integral() const {
   Eigen::VectorXd fv = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
+  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
   for (const auto& s : impl_->segments) {
     const int na = interface_nodes_[static_cast<std::size_t>(s.iface_a)], nb = interface_nodes_[static_cast<std::size_t>(s.iface_b)];
-    const double length = (X_.row(nb) - X_.row(na)).norm();
+    const double length = (X.row(nb) - X.row(na)).norm();
     const Eigen::Vector2d va = U_.segment<2>(3 * na), vb = U_.segment<2>(3 * nb);
     fv.segment<2>(2 * s.iface_a) += length / 6.0 * (2 * va + vb);
     fv.segment<2>(2 * s.iface_b) += length / 6.0 * (va + 2 * vb);
@@ -452,9 +459,10 @@ Eigen::SparseMatrix<double> NavierStokesSolver::interface_mass() const {
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(4 * impl_->segments.size());
+  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
   for (const auto& s : impl_->segments) {
     const int na = interface_nodes_[static_cast<std::size_t>(s.iface_a)], nb = interface_nodes_[static_cast<std::size_t>(s.iface_b)];
-    const double length = (X_.row(nb) - X_.row(na)).norm();
+    const double length = (X.row(nb) - X.row(na)).norm();
     t.emplace_back(s.iface_a, s.iface_a, length / 3.0);
     t.emplace_back(s.iface_b, s.iface_b, length / 3.0);
     t.emplace_back(s.iface_a, s.iface_b, length / 6.0);
@@ -471,9 +479,10 @@ Eigen::VectorXd NavierStokesSolver::interface_traction() const {
   for (Eigen::Index i = 0; i < ni; ++i) f.segment<2>(2 * i) = reaction_.segment<2>(3 * interface_nodes_[static_cast<std::size_t>(i)]);
   // + gamma_N1 int N^T (v_f - v_s): with M_G the interface mass, int N^T v_s = M_G v_s.
   Eigen::VectorXd ms = Eigen::VectorXd::Zero(2 * ni);
+  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
   for (const auto& s : impl_->segments) {
     const int na = interface_nodes_[static_cast<std::size_t>(s.iface_a)], nb = interface_nodes_[static_cast<std::size_t>(s.iface_b)];
-    const double length = (X_.row(nb) - X_.row(na)).norm();
+    const double length = (X.row(nb) - X.row(na)).norm();
     const Eigen::Vector2d va = interface_velocity_.segment<2>(2 * s.iface_a), vb = interface_velocity_.segment<2>(2 * s.iface_b);
     ms.segment<2>(2 * s.iface_a) += length / 6.0 * (2 * va + vb);
     ms.segment<2>(2 * s.iface_b) += length / 6.0 * (va + 2 * vb);

@@ -334,22 +334,31 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
         vs.row(kEdgeNodes[ie.edge][j]) = interface_velocity_.segment<2>(2 * ie.iface[static_cast<std::size_t>(j)]).transpose();
       Eigen::Matrix<double, 15, 15> local = Eigen::Matrix<double, 15, 15>::Zero();
       Eigen::Matrix<double, 15, 1> local_rhs = Eigen::Matrix<double, 15, 1>::Zero();
+      Eigen::Matrix<double, 6, 2> x_pen = x;  // the penalty term's geometry
+      if (params_.penalty_on_step_start)
+        for (int k = 0; k < 6; ++k) x_pen.row(k) = X_n_.row(nodes(k));
       for (int g = 0; g < 4; ++g) {
         const auto p = edge_point(x, ie.edge, kGaussX[g]);
         const double w = kGaussW[g] * p.ds;
+        const double w_pen = params_.penalty_on_step_start ? kGaussW[g] * edge_point(x_pen, ie.edge, kGaussX[g]).ds : w;
         const Eigen::Matrix<double, 6, 1> gn = p.G * p.normal;
         const Eigen::RowVector2d v = p.N.transpose() * vs;
         for (int i = 0; i < 6; ++i) {
           for (int j = 0; j < 6; ++j) {
-            const double vel = g1 * p.N(i) * p.N(j) - mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j);
-            for (int c = 0; c < 2; ++c) local(2 * i + c, 2 * j + c) += w * vel;
+            // (the default's arithmetic exactly as before the penalty_geometry option)
+            const double vel = params_.penalty_on_step_start
+                                   ? w_pen * g1 * p.N(i) * p.N(j) + w * (-mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j))
+                                   : w * (g1 * p.N(i) * p.N(j) - mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j));
+            for (int c = 0; c < 2; ++c) local(2 * i + c, 2 * j + c) += vel;
           }
           for (int j = 0; j < 3; ++j)
             for (int c = 0; c < 2; ++c) {
               local(2 * i + c, 12 + j) += w * p.N(i) * p.normal(c) * p.L(j);
               local(12 + j, 2 * i + c) += w * g2 * p.L(j) * p.normal(c) * p.N(i);
             }
-          for (int c = 0; c < 2; ++c) local_rhs(2 * i + c) += w * (g1 * p.N(i) - g2 * mu * gn(i)) * v(c);
+          for (int c = 0; c < 2; ++c)
+            local_rhs(2 * i + c) += params_.penalty_on_step_start ? (w_pen * g1 * p.N(i) - w * g2 * mu * gn(i)) * v(c)
+                                                                  : w * (g1 * p.N(i) - g2 * mu * gn(i)) * v(c);
         }
         for (int j = 0; j < 3; ++j) local_rhs(12 + j) += w * g2 * p.L(j) * v.dot(p.normal.transpose());
       }
@@ -439,10 +448,11 @@ Eigen::Vector2d TaylorHoodSolver::force(const std::vector<std::string>& groups) 
 // int N_i v over the interface edges, at the interface nodes; v given per interface node.
 Eigen::VectorXd TaylorHoodSolver::edge_integral(const Eigen::VectorXd& values) const {
   Eigen::VectorXd out = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
+  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
   for (const auto& ie : impl_->edges) {
     Eigen::Matrix<double, 6, 2> x;
     const auto nodes = mesh_.element_nodes6(ie.element);
-    for (int k = 0; k < 6; ++k) x.row(k) = X_.row(nodes(k));
+    for (int k = 0; k < 6; ++k) x.row(k) = X.row(nodes(k));
     for (int g = 0; g < 4; ++g) {
       const auto p = edge_point(x, ie.edge, kGaussX[g]);
       Eigen::Vector2d v = Eigen::Vector2d::Zero();
@@ -458,10 +468,11 @@ Eigen::SparseMatrix<double> TaylorHoodSolver::interface_mass() const {
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(9 * impl_->edges.size());
+  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
   for (const auto& ie : impl_->edges) {
     Eigen::Matrix<double, 6, 2> x;
     const auto nodes = mesh_.element_nodes6(ie.element);
-    for (int k = 0; k < 6; ++k) x.row(k) = X_.row(nodes(k));
+    for (int k = 0; k < 6; ++k) x.row(k) = X.row(nodes(k));
     Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
     for (int g = 0; g < 4; ++g) {
       const auto p = edge_point(x, ie.edge, kGaussX[g]);

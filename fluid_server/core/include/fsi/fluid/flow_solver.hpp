@@ -55,6 +55,12 @@ struct FlowParameters {
   StabilisationParameters stabilisation;
   double nitsche_penalty = 0;    // gamma_N1
   double nitsche_symmetry = -1;  // gamma_N2 (+1 symmetric, -1 unsymmetric)
+  // The penalty term gamma_N1 int w . (v - v_s) (and f_v, and the interface mass sent to the
+  // coupler) on the interface of the last accepted step instead of the current one: the
+  // coupler's M_G = H^T M_f H is then constant within a time step, so Algorithm 2's
+  // iterations do not see gamma_N1 dM/dx (robust converged coupling at large gamma_N1). The
+  // consistency and symmetry terms stay on the current interface.
+  bool penalty_on_step_start = false;
   int threads = 1;
   int umfpack_irstep = 0;
   Ordering ordering = Ordering::Auto;
