@@ -212,6 +212,42 @@ def resume_refused(env):
     print("refused: non-empty --out, a changed scene (keys named), --resume without checkpoints")
 
 
+def fork(env):
+    """fsi run --from: a run continued from another run's checkpoint into a new folder. With
+    the scene unchanged it writes exactly the original's rows after the checkpoint; with a
+    changed key it lists the change; the original folder is not touched."""
+    sets = ["time.end=4", "time.checkpoint_every=100", "time.checkpoint_keep=5", "coupling.gamma_n1=10"]
+    ref = env.out("fork_ref")
+    code, log = env.fsi("sdof_model.yaml", ref, *sets)
+    assert code == 0, log
+    before = {n: read(os.path.join(ref, n)) for n in ("probes.csv", "iterations.csv", "summary.json")}
+    same = env.out("fork_same")
+    code, log = env.fsi("sdof_model.yaml", same, *sets,
+                        extra=("--from", os.path.join(ref, "checkpoints", "step_00000100")))
+    assert code == 0, log
+    s = summary(same)
+    assert s["status"] == "completed" and s["forked_from"]["step"] == 100 and s["forked_from"]["changed"] == [], s
+    ref_lines = read(os.path.join(ref, "probes.csv")).split(b"\n")
+    fork_lines = read(os.path.join(same, "probes.csv")).split(b"\n")
+    assert fork_lines[0] == ref_lines[0] and fork_lines[1:] == ref_lines[101:], "forked rows differ from the original's"
+    changed = env.out("fork_changed")
+    code, log = env.fsi("sdof_model.yaml", changed, *sets[:3], "coupling.gamma_n1=100", extra=("--from", ref))
+    assert code == 0, log
+    s = summary(changed)
+    assert s["forked_from"]["step"] == 100, s["forked_from"]  # the newest checkpoint of the 200-step run
+    assert any(c.startswith("coupling.gamma_n1: 10 (checkpoint) vs 100 (now)") for c in s["forked_from"]["changed"]), s
+    assert rows(os.path.join(changed, "probes.csv")) == 200 - s["forked_from"]["step"], s
+    for n, b in before.items():
+        assert read(os.path.join(ref, n)) == b, f"--from changed the original's {n}"
+    code, log = env.fsi("sdof_model.yaml", env.out("fork_bad"), *sets, extra=("--from", env.out("nowhere")))
+    assert code == 1 and "--from" in log and "checkpoint" in log, log
+    code, log = env.fsi("sdof_model.yaml", same, *sets, extra=("--from", ref, "--resume"))
+    assert code == 1 and "exclude each other" in log, log
+    print(f"fork: unchanged fork = the original's rows 101-200 byte for byte; gamma_N1 10 -> 100 forked from step "
+          f"{s['forked_from']['step']} and listed; the original untouched; a folder without checkpoints and "
+          f"--from with --resume refused")
+
+
 # ------------------------------------------------------------------------------ recovery
 RECOVER_SETS = ["time.end=2", "time.checkpoint_every=5"]
 
@@ -429,5 +465,5 @@ def vtk_output(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fsi3, resume_refused, recover_kill,
+    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fsi3, resume_refused, fork, recover_kill,
                                   recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers, vtk_output)})
