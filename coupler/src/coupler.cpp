@@ -317,6 +317,37 @@ RunOutcome Coupler::run(RunReport& report) {
       work_fluid_on_solid = c.real("work_fluid_on_solid");
       out.iterations = static_cast<long>(c.integer("iterations"));
       accelerator.load(c, "accelerator.");
+      if (at_fork) {
+        // F_n holds the algorithm's own Robin part: Algorithm 2's force is the load the solid
+        // felt plus gamma_N1 C v_n. Forked into another algorithm or gamma_N1, convert it (the
+        // predictor of the next step), and drop the accelerator's reused secant pairs (they
+        // live in the old force's space).
+        const auto& old = restart->manifest.value("parameters", nlohmann::json::object()).value("coupling", nlohmann::json::object());
+        auto number = [](const nlohmann::json& j, const char* key, double fallback) {
+          if (!j.contains(key)) return fallback;
+          const auto& v = j.at(key);
+          return v.is_number() ? v.get<double>() : v.is_string() ? std::stod(v.get<std::string>()) : fallback;
+        };
+        const int old_algorithm = static_cast<int>(number(old, "algorithm", static_cast<double>(settings_.algorithm)));
+        const double old_gamma = number(old, "gamma_n1", gamma);
+        if (old_algorithm != static_cast<int>(settings_.algorithm) || old_gamma != gamma) {
+          const NodalMatrix c_mass = mapped_mass.rows() > 0 ? mapped_mass : nodal_interface_mass(solid_interface_, {});
+          if (!c.has("v_s_prev"))
+            log->warn("checkpoint {} holds no interface velocity (an earlier version): the first step's predictor "
+                      "keeps the old algorithm's force", restart->dir.string());
+          else {
+            for (Eigen::VectorXd* f : {&force_n, &force_nm1}) {
+              if (old_algorithm == 2 && old_gamma > 0) *f -= old_gamma * apply_nodal(c_mass, v_s_prev);
+              if (implicit && gamma > 0) *f += gamma * apply_nodal(c_mass, v_s_prev);
+            }
+            data["forked_from"]["predictor_converted"] = true;
+          }
+          accelerator = InterfaceAccelerator(settings_);
+          log->info("forked from algorithm {} (gamma_N1 {}) into algorithm {} (gamma_N1 {}): the force predictor "
+                    "converted, the reused secant pairs dropped",
+                    old_algorithm, old_gamma, static_cast<int>(settings_.algorithm), gamma);
+        }
+      }
       wall_before = restart->manifest.value("wall_seconds", 0.0);
       out.steps = step;
       out.resumed_from = step;
