@@ -577,7 +577,7 @@ RunOutcome Coupler::run(RunReport& report) {
         for (std::size_t i = 0; i < n_measures; ++i)
           missed += fmt::format("{}{} {:.3e} (limit {:.1e})", missed.empty() ? "" : ", ", settings_.measures[i].name(),
                                 values[i], settings_.measures[i].limit);
-        throw Stop{"diverged", fmt::format("coupling not converged in {} iterations at step {}: {} (force residual "
+        throw Stop{"diverged", fmt::format("coupling tolerance not reached in {} iterations at step {}: {} (force residual "
                                            "{:.3e}, first {:.3e})",
                                            settings_.max_iterations, n, missed, residual, first_residual)};
       }

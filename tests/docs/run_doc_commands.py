@@ -118,6 +118,11 @@ SKIP = {
     "/usr/bin/python3 bench/fsi/th_stats.py CASE RUN_DIR [--window W] [--t-end T] [--plot PNG] [--json OUT]":
         "synopsis (placeholders); its ctest is python.stats",
     "bench/fsi/run_turek_hron.sh fsi1 runs/fsi1": "benchmark: Turek-Hron FSI1, minutes; CI: ctest fsi.fsi1",
+    "build/bin/fsi run configs/fsi2_p2p1.yaml --out runs/fsi2_base --set time.end=7.6 --set time.checkpoint_every=250":
+        "benchmark: FSI2 (P2/P1) to t = 7.6, about 11 minutes; --from is tested by ctest integration.resilience.fork",
+    "build/bin/fsi run configs/fsi2_p2p1.yaml --out runs/fsi2_a1 --from runs/fsi2_base --set time.end=9.1 --set "
+    "coupling.algorithm=1 --set coupling.iterations.tolerance=0 --set \"coupling.iterations.measures=[{quantity: traction, "
+    "type: relative, limit: 1.0e-4}]\"": "benchmark: the fork of the FSI2 run above to t = 9.1, about 7 minutes",
     "bench/fsi/run_turek_hron.sh fsi3 runs/fsi3": "benchmark: Turek-Hron FSI3, 895 s",
     "bench/fsi/run_turek_hron.sh fsi2 runs/fsi2": "benchmark: Turek-Hron FSI2, 708 s",
     FSI3_B: "benchmark: FSI3 to t = 3.5",
