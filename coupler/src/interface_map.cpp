@@ -92,26 +92,14 @@ NodalMatrix nodal_interface_mass(const InterfaceMeshData& solid, const Eigen::Ve
 }
 
 Eigen::SparseMatrix<double> interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement) {
-  const Eigen::Index n = solid.coordinates.rows();
-  Eigen::SparseMatrix<double> m(2 * n, 2 * n);
+  // The nodal mass acting on both components: (M (x) I_2).
+  const NodalMatrix nodal = nodal_interface_mass(solid, displacement);
   std::vector<Eigen::Triplet<double>> t;
-  if (solid.segments.empty()) {
-    for (Eigen::Index i = 0; i < n; ++i)
-      for (int c = 0; c < 2; ++c) t.emplace_back(2 * i + c, 2 * i + c, solid.lumped_measure[i]);
-  } else {
-    auto x = [&](int i) {
-      Eigen::Vector2d p = solid.coordinates.row(i).transpose();
-      if (displacement.size() == 2 * n) p += displacement.segment<2>(2 * i);
-      return p;
-    };
-    for (const auto& seg : solid.segments) {
-      const double len = (x(seg[1]) - x(seg[0])).norm();
-      const double mij[2][2] = {{len / 3, len / 6}, {len / 6, len / 3}};
-      for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 2; ++b)
-          for (int c = 0; c < 2; ++c) t.emplace_back(2 * seg[a] + c, 2 * seg[b] + c, mij[a][b]);
-    }
-  }
+  t.reserve(2 * static_cast<std::size_t>(nodal.nonZeros()));
+  for (int col = 0; col < nodal.outerSize(); ++col)
+    for (NodalMatrix::InnerIterator it(nodal, col); it; ++it)
+      for (int c = 0; c < 2; ++c) t.emplace_back(2 * it.row() + c, 2 * it.col() + c, it.value());
+  Eigen::SparseMatrix<double> m(2 * nodal.rows(), 2 * nodal.cols());
   m.setFromTriplets(t.begin(), t.end());
   return m;
 }
