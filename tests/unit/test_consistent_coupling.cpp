@@ -88,6 +88,9 @@ class PenaltyFluid : public fsi::FluidModel {
     return {};
   }
   bool supports_output() const override { return false; }
+  bool supports_checkpoint() const override { return true; }
+  void save_state(fsi::StateArchive& state) override { state.put("penalty_fluid.v_n", v_n_); }
+  void load_state(const fsi::StateArchive& state) override { v_n_ = v_ = state.vector("penalty_fluid.v_n", v_n_.size()); }
 
  private:
   Eigen::MatrixX2d x_;
@@ -98,7 +101,7 @@ class PenaltyFluid : public fsi::FluidModel {
 std::string scene_text(int algorithm, double gamma, const std::string& extra) {
   std::ostringstream s;
   s << "scene: consistent\n"
-    << "time: {dt: 0.01, end: 0.2}\n"
+    << "time: {dt: 0.01, end: 0.2, checkpoint_every: 10}\n"
     << "coupling:\n  algorithm: " << algorithm << "\n  gamma_n1: " << gamma << "\n  relaxation: 0.5\n"
     << "  acceleration: iqn-ils\n  iqn: {reuse_steps: 0}\n"
     << "  iterations: {max: 60, tolerance: 1.0e-13, stop_if_not_converged: false}\n" << extra
@@ -112,23 +115,33 @@ std::string scene_text(int algorithm, double gamma, const std::string& extra) {
 }
 
 struct Result {
+  fs::path dir;
   std::vector<double> tip_y, uncancelled;
   fsi::coupling::RunOutcome outcome;
 };
 
-Result run(int algorithm, double gamma, const std::string& extra = "") {
+// Runs the scene in DIR/out; with `fork_from` (another run's folder) first copies its
+// checkpoint of step 10 there and continues from it, as fsi run --from does.
+Result run(int algorithm, double gamma, const std::string& extra = "", const fs::path& fork_from = {},
+           bool keep = false) {
   const auto dir = fs::temp_directory_path() / ("fsi_consistent_" + std::to_string(::getpid()) + "_" +
                                                 std::to_string(algorithm) + "_" + std::to_string(int(gamma)) +
-                                                std::to_string(extra.size()));
+                                                std::to_string(extra.size()) + (fork_from.empty() ? "" : "_fork"));
   fs::remove_all(dir);
-  fs::create_directories(dir);
+  fs::create_directories(dir / "out");
+  if (!fork_from.empty()) {
+    fs::create_directories(dir / "out" / "checkpoints");
+    fs::copy(fork_from / "out" / "checkpoints" / "step_00000010", dir / "out" / "checkpoints" / "step_00000010",
+             fs::copy_options::recursive);
+    std::ofstream(dir / "out" / "forked_from.json") << R"({"step": 10, "iterations": 0})";
+  }
   { std::ofstream(dir / "scene.yaml") << scene_text(algorithm, gamma, extra); }
   const auto scene = fsi::Scene::load(dir / "scene.yaml", {});
   fsi::solid::FemSolid solid;
   PenaltyFluid fluid(9, 0.0, 1.0, 0.1);  // 9 fluid nodes against 13 solid nodes, not at the same places
   fsi::RunReport report(dir / "out", scene, "test");
-  fs::create_directories(dir / "out");
   fsi::coupling::Coupler coupler(solid, fluid, scene, dir / "out");
+  coupler.set_resume(!fork_from.empty());
   Result r;
   r.outcome = coupler.run(report);
   std::ifstream in(dir / "out" / "probes.csv");
@@ -150,7 +163,8 @@ Result run(int algorithm, double gamma, const std::string& extra = "") {
     r.tip_y.push_back(row[static_cast<std::size_t>(iy)]);
     r.uncancelled.push_back(row[static_cast<std::size_t>(iu)]);
   }
-  fs::remove_all(dir);
+  if (!keep) fs::remove_all(dir);
+  r.dir = dir;
   return r;
 }
 
@@ -192,6 +206,19 @@ TEST(ConsistentCoupling, ConvergedAlgorithms1And2AgreeOnNonMatchingDeformingInte
   EXPECT_LT(max_relative_difference(a1.tip_y, a2.tip_y), 1e-8);
   for (double w : a1.uncancelled) EXPECT_EQ(w, 0.0);
   for (double w : a2.uncancelled) EXPECT_EQ(w, 0.0);
+}
+
+// Forked at step 10 from converged Algorithm 2 into Algorithm 1 (the force predictor converted
+// from Algorithm 2's F = load + gamma M_G v to Algorithm 1's): the same steps 11-20.
+TEST(ConsistentCoupling, ForkedFromAlgorithm2IntoAlgorithm1GivesTheSameSteps) {
+  const Result a2 = run(2, 1000, "", {}, true);
+  ASSERT_EQ(a2.outcome.status, "completed") << a2.outcome.reason;
+  const Result a1 = run(1, 1000, "", a2.dir);
+  fs::remove_all(a2.dir);
+  ASSERT_EQ(a1.outcome.status, "completed") << a1.outcome.reason;
+  ASSERT_EQ(a1.tip_y.size(), 10u);
+  const std::vector<double> tail(a2.tip_y.begin() + 10, a2.tip_y.end());
+  EXPECT_LT(max_relative_difference(tail, a1.tip_y), 1e-8);
 }
 
 TEST(ConsistentCoupling, TheSolidsOwnMassLeavesAnUncancelledTermThatChangesTheAnswer) {
