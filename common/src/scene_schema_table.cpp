@@ -71,10 +71,6 @@ std::vector<Key> coupling_keys() {
       section("iqn", "IQN-ILS options",
               {
                   integer("reuse_steps", "secant pairs are kept from the last N steps").def("8").ge(0),
-                  choice("new_directions", {"full", "relaxed"},
-                         "the residual outside the secant columns' span: a full step (classic IQN-ILS) or beta "
-                         "times it (robust under strong added mass)")
-                      .def("full"),
                   number("filter", "drop a column whose orthogonal remainder is below filter x its norm")
                       .def("0.001")
                       .gt(0)

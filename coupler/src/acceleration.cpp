@@ -128,12 +128,6 @@ Eigen::VectorXd InterfaceAccelerator::quasi_newton(const Eigen::VectorXd& x, con
   Eigen::VectorXd next = xt;
   for (Eigen::Index j = 0; j < m; ++j) next += c(j) * *kept_w[j];
   last_omega_ = 0;
-  if (settings_.iqn_relax_new_directions) {
-    // next = x + (W - V) c + r_perp with r_perp = r + V c (what the columns cannot explain):
-    // take beta r_perp instead of the full r_perp.
-    const Eigen::VectorXd r_perp = r + q.leftCols(m) * (rr.topLeftCorner(m, m) * c);
-    next -= (1.0 - settings_.relaxation) * r_perp;
-  }
   return next;
 }
 

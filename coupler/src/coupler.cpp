@@ -65,11 +65,15 @@ NodalMatrix Coupler::algorithm1_mass(const Eigen::VectorXd& solid_displacement, 
   return nodal_interface_mass(solid_interface_, solid_displacement);  // the solid's polyline, current configuration
 }
 
-NodalMatrix Coupler::solid_damping_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
-  if (settings_.algorithm != Algorithm::ImplicitSolidVelocity) return NodalMatrix();
+NodalMatrix Coupler::solid_damping_mass(const NodalMatrix& mapped_mass) const {
+  if (settings_.algorithm != Algorithm::ImplicitSolidVelocity || settings_.nitsche_penalty == 0) return NodalMatrix();
   if (consistent_damping_ && mapped_mass.rows() > 0) return mapped_mass;
-  (void)solid_displacement;
   return nodal_interface_mass(solid_interface_, Eigen::VectorXd());  // the solid's own, reference configuration
+}
+
+NodalMatrix Coupler::physical_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
+  if (mapped_mass.rows() > 0) return mapped_mass;
+  return nodal_interface_mass(solid_interface_, solid_displacement);  // a fluid without M_f: the solid's polyline
 }
 
 RunOutcome Coupler::run(RunReport& report) {
@@ -454,15 +458,10 @@ RunOutcome Coupler::run(RunReport& report) {
         const StepInfo info{t_np1, time.dt, n, k};
         // Algorithm 2: the damping operator of this solve: H^T M_f H of the fluid's last solve
         // (consistent), or the solid's own int N^T N.
-        NodalMatrix damping;
-        if (implicit && gamma > 0) {
-          if (consistent_damping_ && mapped_mass.rows() > 0) {
-            damping = mapped_mass;
-            Timer t(solid_time);
-            solid_.set_interface_mass(damping);
-          } else {
-            damping = nodal_interface_mass(solid_interface_, Eigen::VectorXd());
-          }
+        const NodalMatrix damping = solid_damping_mass(mapped_mass);
+        if (consistent_damping_ && mapped_mass.rows() > 0) {
+          Timer t(solid_time);
+          solid_.set_interface_mass(damping);
         }
         SolidStepResult s;
         {
@@ -492,9 +491,9 @@ RunOutcome Coupler::run(RunReport& report) {
           // The physical traction H^T R = f_sigma - gamma (f_v - M_f v_s) (the fluid's reaction,
           // without its penalty part), and its mismatch with what the solid felt: its load
           // F^(k) minus its own Robin damping gamma C v_s.
-          const NodalMatrix m_phys =
-              mass_k.rows() > 0 ? mass_k : nodal_interface_mass(solid_interface_, s.interface_displacement);
-          traction = gamma > 0 ? Eigen::VectorXd(fs - gamma * (fv - apply_nodal(m_phys, s.interface_velocity))) : fs;
+          traction = gamma > 0 ? Eigen::VectorXd(fs - gamma * (fv - apply_nodal(physical_mass(s.interface_displacement, mass_k),
+                                                                                 s.interface_velocity)))
+                               : fs;
           traction_change = traction + force;
           if (damping.rows() > 0) traction_change -= gamma * apply_nodal(damping, s.interface_velocity);
           // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
@@ -610,9 +609,8 @@ RunOutcome Coupler::run(RunReport& report) {
         if (damping_last.rows() > 0) load -= gamma * apply_nodal(damping_last, v);
         double uncancelled = 0;
         if (gamma > 0) {
-          const NodalMatrix m_phys =
-              mass_last.rows() > 0 ? mass_last : nodal_interface_mass(solid_interface_, s_last.interface_displacement);
-          const NodalMatrix c_cfg = implicit ? solid_damping_mass(s_last.interface_displacement, mass_last)
+          const NodalMatrix m_phys = physical_mass(s_last.interface_displacement, mass_last);
+          const NodalMatrix c_cfg = implicit ? solid_damping_mass(mass_last)
                                              : algorithm1_mass(s_last.interface_displacement, mass_last);
           uncancelled = gamma * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
         }

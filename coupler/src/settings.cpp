@@ -57,11 +57,6 @@ CouplingSettings read_coupling(const ConfigSection& s) {
     if (c.reuse_steps < 0) iqn.fail("reuse_steps", "must be >= 0");
     c.iqn_filter = iqn.get<double>("filter", 1e-3);
     if (!(c.iqn_filter > 0 && c.iqn_filter < 1)) iqn.fail("filter", "must be in (0, 1)");
-    const auto directions = iqn.get<std::string>("new_directions", "full");
-    if (directions == "relaxed") c.iqn_relax_new_directions = true;
-    else if (directions != "full")
-      iqn.fail("new_directions", "must be 'full' (the classic IQN-ILS) or 'relaxed' (beta times the residual outside "
-                                 "the secant columns)");
   }
   const auto it = s.child("iterations");
   c.max_iterations = it.get<int>("max");

@@ -31,6 +31,22 @@ struct Run {
   }
 };
 
+// A CSV table of numbers: its header and rows.
+void read_csv(const fs::path& path, std::vector<std::string>& columns, std::vector<std::vector<double>>& rows) {
+  std::ifstream in(path);
+  std::string line;
+  if (std::getline(in, line)) {
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) columns.push_back(c);
+  }
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::vector<double> row;
+    for (std::string c; std::getline(ss, c, ',');) row.push_back(std::stod(c));
+    rows.push_back(row);
+  }
+}
+
 Run run_scene(const std::vector<std::string>& overrides) {
   const auto scene = fsi::Scene::load(fs::path(FSI_SOURCE_DIR) / "configs/sdof_model.yaml", overrides);
   const auto out = fs::temp_directory_path() / ("fsi_unit_" + std::to_string(::getpid()) + "_" +
@@ -44,29 +60,8 @@ Run run_scene(const std::vector<std::string>& overrides) {
   fsi::coupling::Coupler coupler(solid, fluid, scene, out);
   Run run;
   run.outcome = coupler.run(report);
-  std::ifstream in(out / "probes.csv");
-  std::string line;
-  if (std::getline(in, line)) {
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) run.columns.push_back(c);
-  }
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::vector<double> row;
-    for (std::string c; std::getline(ss, c, ',');) row.push_back(std::stod(c));
-    run.rows.push_back(row);
-  }
-  std::ifstream it(out / "iterations.csv");
-  if (std::getline(it, line)) {
-    std::stringstream ss(line);
-    for (std::string c; std::getline(ss, c, ',');) run.iteration_columns.push_back(c);
-  }
-  while (std::getline(it, line)) {
-    std::stringstream ss(line);
-    std::vector<double> row;
-    for (std::string c; std::getline(ss, c, ',');) row.push_back(std::stod(c));
-    run.iteration_rows.push_back(row);
-  }
+  read_csv(out / "probes.csv", run.columns, run.rows);
+  read_csv(out / "iterations.csv", run.iteration_columns, run.iteration_rows);
   fs::remove_all(out);
   return run;
 }

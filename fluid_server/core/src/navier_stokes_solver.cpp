@@ -443,16 +443,10 @@ Eigen::Vector2d NavierStokesSolver::force(const std::vector<std::string>& groups
 }
 
 Eigen::VectorXd NavierStokesSolver::interface_velocity_integral() const {
-  Eigen::VectorXd fv = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
-  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
-  for (const auto& s : impl_->segments) {
-    const int na = interface_nodes_[static_cast<std::size_t>(s.iface_a)], nb = interface_nodes_[static_cast<std::size_t>(s.iface_b)];
-    const double length = (X.row(nb) - X.row(na)).norm();
-    const Eigen::Vector2d va = U_.segment<2>(3 * na), vb = U_.segment<2>(3 * nb);
-    fv.segment<2>(2 * s.iface_a) += length / 6.0 * (2 * va + vb);
-    fv.segment<2>(2 * s.iface_b) += length / 6.0 * (va + 2 * vb);
-  }
-  return fv;
+  Eigen::VectorXd vf(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
+  for (std::size_t i = 0; i < interface_nodes_.size(); ++i)
+    vf.segment<2>(2 * static_cast<Eigen::Index>(i)) = U_.segment<2>(3 * interface_nodes_[i]);
+  return apply_nodal(interface_mass(), vf);  // f_v = M_f v_f, the penalty term's own operator
 }
 
 Eigen::SparseMatrix<double> NavierStokesSolver::interface_mass() const {
@@ -477,17 +471,8 @@ Eigen::VectorXd NavierStokesSolver::interface_traction() const {
   const Eigen::Index ni = static_cast<Eigen::Index>(interface_nodes_.size());
   Eigen::VectorXd f(2 * ni);
   for (Eigen::Index i = 0; i < ni; ++i) f.segment<2>(2 * i) = reaction_.segment<2>(3 * interface_nodes_[static_cast<std::size_t>(i)]);
-  // + gamma_N1 int N^T (v_f - v_s): with M_G the interface mass, int N^T v_s = M_G v_s.
-  Eigen::VectorXd ms = Eigen::VectorXd::Zero(2 * ni);
-  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
-  for (const auto& s : impl_->segments) {
-    const int na = interface_nodes_[static_cast<std::size_t>(s.iface_a)], nb = interface_nodes_[static_cast<std::size_t>(s.iface_b)];
-    const double length = (X.row(nb) - X.row(na)).norm();
-    const Eigen::Vector2d va = interface_velocity_.segment<2>(2 * s.iface_a), vb = interface_velocity_.segment<2>(2 * s.iface_b);
-    ms.segment<2>(2 * s.iface_a) += length / 6.0 * (2 * va + vb);
-    ms.segment<2>(2 * s.iface_b) += length / 6.0 * (va + 2 * vb);
-  }
-  return f + params_.nitsche_penalty * (interface_velocity_integral() - ms);
+  // + gamma_N1 int N^T (v_f - v_s) = gamma_N1 (f_v - M_f v_s)
+  return f + params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));
 }
 
 bool NavierStokesSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const {

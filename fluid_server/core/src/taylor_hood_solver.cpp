@@ -445,25 +445,6 @@ Eigen::Vector2d TaylorHoodSolver::force(const std::vector<std::string>& groups) 
   return f;
 }
 
-// int N_i v over the interface edges, at the interface nodes; v given per interface node.
-Eigen::VectorXd TaylorHoodSolver::edge_integral(const Eigen::VectorXd& values) const {
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
-  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
-  for (const auto& ie : impl_->edges) {
-    Eigen::Matrix<double, 6, 2> x;
-    const auto nodes = mesh_.element_nodes6(ie.element);
-    for (int k = 0; k < 6; ++k) x.row(k) = X.row(nodes(k));
-    for (int g = 0; g < 4; ++g) {
-      const auto p = edge_point(x, ie.edge, kGaussX[g]);
-      Eigen::Vector2d v = Eigen::Vector2d::Zero();
-      for (int j = 0; j < 3; ++j) v += p.N(kEdgeNodes[ie.edge][j]) * values.segment<2>(2 * ie.iface[static_cast<std::size_t>(j)]);
-      for (int j = 0; j < 3; ++j)
-        out.segment<2>(2 * ie.iface[static_cast<std::size_t>(j)]) += kGaussW[g] * p.ds * p.N(kEdgeNodes[ie.edge][j]) * v;
-    }
-  }
-  return out;
-}
-
 Eigen::SparseMatrix<double> TaylorHoodSolver::interface_mass() const {
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   std::vector<Eigen::Triplet<double>> t;
@@ -492,14 +473,14 @@ Eigen::VectorXd TaylorHoodSolver::interface_velocity_integral() const {
   Eigen::VectorXd vf(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
   for (std::size_t i = 0; i < interface_nodes_.size(); ++i)
     vf.segment<2>(2 * static_cast<Eigen::Index>(i)) = U_.segment<2>(2 * interface_nodes_[i]);
-  return edge_integral(vf);
+  return apply_nodal(interface_mass(), vf);  // f_v = M_f v_f, the penalty term's own operator
 }
 
 Eigen::VectorXd TaylorHoodSolver::interface_traction() const {
   const Eigen::Index ni = static_cast<Eigen::Index>(interface_nodes_.size());
   Eigen::VectorXd f(2 * ni);
   for (Eigen::Index i = 0; i < ni; ++i) f.segment<2>(2 * i) = reaction_.segment<2>(2 * interface_nodes_[static_cast<std::size_t>(i)]);
-  return f + params_.nitsche_penalty * (interface_velocity_integral() - edge_integral(interface_velocity_));
+  return f + params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));
 }
 
 bool TaylorHoodSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const {

@@ -77,8 +77,12 @@ class Coupler {
   // Algorithm 1's M_G in F* (robin_mass: consistent = mapped_mass; solid = the polyline mass
   // in the current configuration).
   NodalMatrix algorithm1_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const;
-  // The solid's damping operator in a configuration (Algorithm 2; empty for Algorithm 1).
-  NodalMatrix solid_damping_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const;
+  // The solid's damping operator C (Algorithm 2 with gamma_N1 > 0; else empty): mapped_mass
+  // when the solid takes it, else the solid's own reference int N^T N.
+  NodalMatrix solid_damping_mass(const NodalMatrix& mapped_mass) const;
+  // The operator of the fluid's penalty term seen from the solid: mapped_mass, or without one
+  // (a fluid that does not send M_f) the solid's polyline mass in the current configuration.
+  NodalMatrix physical_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const;
   bool consistent_damping_ = false;  // Algorithm 2 and the solid takes H^T M_f H
   SolidModel& solid_;
   FluidModel& fluid_;

@@ -50,10 +50,6 @@ struct CouplingSettings {
   Acceleration acceleration = Acceleration::Constant;
   int reuse_steps = 8;            // IQN-ILS: secant pairs of the last N accepted steps are reused
   double iqn_filter = 1e-3;       // IQN-ILS: drop a column whose orthogonal remainder is below this share
-  // IQN-ILS: the part of the residual outside the secant columns' span gets the full step
-  // (false: the classic method) or beta times it (true: -beta I as the initial inverse
-  // Jacobian, safe under strong added mass, where a full step of an unexplored mode diverges).
-  bool iqn_relax_new_directions = false;
   int max_iterations = 1;         // k_max
   // 0: exactly max_iterations iterations per step (the paper). > 0: iterate until the
   // relative interface residual ||F^(k+1) - F^(k)|| / ||F^(k+1)|| is below it.

@@ -76,7 +76,6 @@ class TaylorHoodSolver : public FlowSolver {
   std::vector<int> interface_nodes_;
   IndexMatrix2 interface_segments_;
   Eigen::VectorXd interface_velocity_;
-  Eigen::VectorXd edge_integral(const Eigen::VectorXd& interface_values) const;  // int N_i v over the interface edges
   bool locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const;
 };
 
