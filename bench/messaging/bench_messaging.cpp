@@ -83,10 +83,10 @@ class EchoFluid : public fsi::FluidModel {
   }
   fsi::InterfaceMeshData interface() const override { return line_interface(n_); }
   fsi::FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override {
-    return {-d, v, 1};
+    return {-d, v, 1, {}};
   }
   fsi::FluidLoads solve_step(const fsi::StepInfo&, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override {
-    return {-1e3 * d, v, 1};  // traction = -force on the solid: the loop stays bounded
+    return {-1e3 * d, v, 1, {}};  // traction = -force on the solid: the loop stays bounded
   }
   std::map<std::string, double> accept_step(const fsi::StepInfo&) override { return {}; }
 

@@ -393,6 +393,14 @@ RunOutcome Coupler::run(RunReport& report) {
         resume_tables ? CsvWriter::resume(out_dir_ / "iterations.csv",
                                           static_cast<std::size_t>(out.iterations - fork_iterations), iteration_columns)
                       : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
+    // Wall time per step (not byte-identical across runs, so apart from probes.csv): cumulative
+    // seconds of the run, its fluid and solid requests, for cost per simulated second.
+    const std::vector<std::string> timing_columns{"step", "time", "wall", "fluid", "solid", "iterations"};
+    const auto timing_path = out_dir_ / "timing.csv";
+    CsvWriter timing = resume_tables && std::filesystem::exists(timing_path)
+                           ? CsvWriter::resume(timing_path, static_cast<std::size_t>(restart->step - fork_step),
+                                               timing_columns)
+                           : CsvWriter(timing_path, timing_columns);
     Progress progress("coupler", time.steps, out.steps);
     const double segment_start = now();
     auto save_checkpoint = [&](int n, double t_np1) {
@@ -635,6 +643,9 @@ RunOutcome Coupler::run(RunReport& report) {
       for (const auto& [name, v] : row)
         if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
       probes.add(t_np1, row);
+      // before the checkpoint of this step, so a checkpoint never has fewer timing rows than steps
+      timing.row(std::vector<double>{double(n), t_np1, wall_before + (now() - segment_start), fluid_time, solid_time,
+                                     double(used)});
       if (time.output_every > 0 && n % time.output_every == 0)
         write_output(accepted, InterfaceFields{s_last.interface_displacement, s_last.interface_velocity, force_applied,
                                                map_.to_solid(loads_last.traction_force),

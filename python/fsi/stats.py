@@ -21,6 +21,10 @@ Periodic signals
                         over the last whole periods (crossings of the midrange with a 10 %
                         hysteresis), frequency = periods / their duration
     ``by_period``       midrange and amplitude of every column, period by period
+    ``moving_average``  centred moving average over a time width (the ripple filter)
+    ``turek_hron_table`` Turek & Hron's statistics of several histories over the same whole
+                        periods of one of them (u_y for FSI2/FSI3), raw and after a moving
+                        average; refuses (StatsError) fewer than ``min_periods`` periods
 Transients
     ``settling_time``   the time after which y stays within a band around its final value
     ``peak``            the largest value and its time
@@ -39,7 +43,7 @@ import numpy as np
 __all__ = [
     "StatsError", "finite", "select_window", "last_seconds", "last_periods", "time_mean", "midrange",
     "amplitude", "crossings", "zero_crossing_frequency", "fft_frequency", "harmonic_amplitudes",
-    "periodic_stats", "turek_hron", "by_period", "settling_time", "peak", "phase_lag", "signal_metrics",
+    "periodic_stats", "turek_hron", "by_period", "moving_average", "turek_hron_table", "settling_time", "peak", "phase_lag", "signal_metrics",
     "compare", "compare_values", "relative_error_percent",
 ]
 
@@ -271,6 +275,60 @@ def by_period(t, cols, key):
             vs = v[sel]
             row[c] = {"midrange": float((np.max(vs) + np.min(vs)) / 2), "amplitude": float((np.max(vs) - np.min(vs)) / 2)}
         out.append(row)
+    return out
+
+
+def moving_average(t, y, width):
+    """Centred moving average: at every t_i the mean of the samples with |t_j - t_i| <= width / 2
+    (fewer near the ends). Works on non-uniform samples; width <= 0 returns y unchanged."""
+    t, y = _arrays(t, y)
+    if not width > 0 or len(y) == 0:
+        return y.copy()
+    cs = np.concatenate(([0.0], np.cumsum(y)))
+    lo = np.searchsorted(t, t - 0.5 * width - 1e-12, side="left")
+    hi = np.searchsorted(t, t + 0.5 * width + 1e-12, side="right")
+    return (cs[hi] - cs[lo]) / (hi - lo)
+
+
+def turek_hron_table(t, cols, key, min_periods=3, periods=None, hysteresis=0.1, smooth=0.0):
+    """Turek & Hron's statistics of several histories over the **same whole periods** of
+    cols[key] (FSI2/FSI3: u_y, whose period contains two of u_x and of the drag).
+
+    The window runs from an upward crossing of key's midrange (hysteresis as in ``turek_hron``)
+    to the last one: the last ``periods`` whole periods (None: all). Per column c:
+    mean = (max + min) / 2 and amplitude = (max - min) / 2 over that window, and the frequency
+    from c's own upward crossings inside it; with smooth > 0 (seconds) also
+    ``mean_smoothed`` / ``amplitude_smoothed`` of the ``moving_average`` (the extrema of a noisy
+    force history otherwise measure its noise). Fewer than min_periods whole periods of key:
+    StatsError (a table over less than that is not a periodic state)."""
+    t = np.asarray(t, float)
+    cols = {c: np.asarray(v, float) for c, v in cols.items()}
+    y = cols[key]
+    hi, lo = float(np.max(y)), float(np.min(y))
+    up = crossings(t, y, 0.5 * (hi + lo), hysteresis * (hi - lo))
+    n = len(up) - 1
+    if n < min_periods:
+        raise StatsError(f"{max(n, 0)} whole period(s) of {key} in t = [{t[0]:.4g}, {t[-1]:.4g}]; "
+                         f"at least {min_periods} are needed (run longer)")
+    if periods is not None:
+        if periods < min_periods:
+            raise StatsError(f"periods = {periods} is fewer than min_periods = {min_periods}")
+        up = up[-min(periods, n) - 1:]
+    t0, t1 = up[0], up[-1]
+    sel = (t >= t0) & (t <= t1)
+    out = {"t0": t0, "t1": t1, "periods": len(up) - 1, "frequency": (len(up) - 1) / (t1 - t0),
+           "smooth": smooth, "columns": {}}
+    for c, v in cols.items():
+        vs, ts = v[sel], t[sel]
+        chi, clo = float(np.max(vs)), float(np.min(vs))
+        cu = crossings(ts, vs, 0.5 * (chi + clo), hysteresis * (chi - clo))
+        row = {"mean": 0.5 * (chi + clo), "amplitude": 0.5 * (chi - clo),
+               "frequency": (len(cu) - 1) / (cu[-1] - cu[0]) if len(cu) >= 2 else float("nan")}
+        if smooth > 0:
+            vm = moving_average(t, v, smooth)[sel]
+            row["mean_smoothed"] = 0.5 * float(np.max(vm) + np.min(vm))
+            row["amplitude_smoothed"] = 0.5 * float(np.max(vm) - np.min(vm))
+        out["columns"][c] = row
     return out
 
 

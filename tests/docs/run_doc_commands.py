@@ -115,7 +115,7 @@ SKIP = {
     "--by-period fluid.lift --reference cfd3": "statistics of the 22-minute CFD3 run",
     # docs/fsi.md: Turek-Hron FSI1-3, coupled runs of minutes to hours.
     "bench/fsi/run_turek_hron.sh CASE [OUT] [fsi run args]": "synopsis (placeholders); the cases follow",
-    "/usr/bin/python3 bench/fsi/th_stats.py CASE RUN_DIR [--window W] [--t-end T] [--plot PNG] [--json OUT]":
+    "/usr/bin/python3 bench/fsi/th_stats.py CASE RUN [--periods N] [--smooth S] [--t-end T] [--plot PNG] [--json OUT]":
         "synopsis (placeholders); its ctest is python.stats",
     "bench/fsi/run_turek_hron.sh fsi1 runs/fsi1": "benchmark: Turek-Hron FSI1, minutes; CI: ctest fsi.fsi1",
     "build/bin/fsi run configs/fsi2_p2p1.yaml --out runs/fsi2_base --set time.end=7.6 --set time.checkpoint_every=250":
@@ -126,7 +126,7 @@ SKIP = {
     "bench/fsi/run_turek_hron.sh fsi3 runs/fsi3": "benchmark: Turek-Hron FSI3, 895 s",
     "bench/fsi/run_turek_hron.sh fsi2 runs/fsi2": "benchmark: Turek-Hron FSI2, 708 s",
     FSI3_B: "benchmark: FSI3 to t = 3.5",
-    "/usr/bin/python3 bench/fsi/th_stats.py fsi3 runs/fsi3_B --window 0.75 --plot docs/img/fsi_fsi3.png":
+    "/usr/bin/python3 bench/fsi/th_stats.py fsi3 runs/fsi3_B --periods 4 --plot docs/img/fsi_fsi3.png":
         "statistics of the FSI3 benchmark run (and it rewrites a committed figure)",
     FSI3_MAIN: "benchmark: FSI3 to t = 5",
     FSI3_AITKEN_SHORT: "coupled FSI3 (36k-unknown fluid, up to 30 iterations per step): minutes even for 0.1 s",

@@ -132,4 +132,35 @@ check(S.settling_time([0, 1, 2], [0, 1, 0.5], final=1.0) is None, "not settled a
 check(S.settling_time([0, 1, 2], [1, 1, 1]) == 0.0, "never outside: t0")
 check(S.peak([0, 1, 2], [0, 3, 1]) == (1.0, 3.0), "peak")
 
+# --- Turek-Hron tables: u_y at f, u_x and drag at 2 f, over the same whole u_y periods; a
+# moving average removes a step-to-step noise that max - min would count; fewer than 3
+# periods are refused.
+fy = 2.0
+tt = np.arange(0.0, 3.0 + 1e-9, 5e-4)
+uy = 1.0 + 80.0 * np.sin(2 * np.pi * fy * tt)
+ux = -14.0 + 12.0 * np.cos(4 * np.pi * fy * tt)
+noise = 10.0 * (-1.0) ** np.arange(len(tt))          # +-10, alternating every sample
+lift = 0.5 + 230.0 * np.sin(2 * np.pi * fy * tt + 0.3) + noise
+tab = S.turek_hron_table(tt, {"uy": uy, "ux": ux, "lift": lift}, "uy", periods=4, smooth=0.005)
+c = tab["columns"]
+check(tab["periods"] == 4, f"turek_hron_table: 4 whole u_y periods ({tab['periods']})")
+close(tab["t1"] - tab["t0"], 4 / fy, 1e-6, "turek_hron_table window = 4 u_y periods")
+close(c["uy"]["amplitude"], 80.0, 80.0 * (1 - math.cos(math.pi * fy * 5e-4)) + 1e-9, "u_y amplitude")
+close(c["ux"]["mean"], -14.0, 1e-3, "u_x midrange over the u_y window")
+close(c["ux"]["amplitude"], 12.0, 1e-3, "u_x amplitude over the u_y window")
+close(c["ux"]["frequency"], 2 * fy, 1e-6, "u_x frequency = 2 f_y from its own crossings")
+close(c["lift"]["amplitude"], 240.0, 0.1, "raw lift amplitude counts the +-10 noise")
+# an 11-sample centred average damps the sine by sin(11 x) / (11 sin x), x = pi f dt, and leaves
+# 1/11 of the alternating noise
+x = math.pi * fy * 5e-4
+damp = math.sin(11 * x) / (11 * math.sin(x))
+close(c["lift"]["amplitude_smoothed"], 230.0 * damp + 10.0 / 11, 0.05, "moving average: the noise down 11 times, the signal kept")
+try:
+    S.turek_hron_table(tt[tt < 1.2], {"uy": uy[tt < 1.2]}, "uy")
+    check(False, "2 whole periods refused")
+except S.StatsError as e:
+    check("at least 3" in str(e), f"2 whole periods refused: {e}")
+ma = S.moving_average([0, 1, 2, 3, 4], [0, 0, 3, 0, 0], 2.0)
+check(np.allclose(ma, [0, 1, 1, 1, 0]), f"moving_average of a spike over 3 samples: {ma}")
+
 sys.exit(1 if failures else 0)
