@@ -137,7 +137,17 @@ RunOutcome Coupler::run(RunReport& report) {
         log->warn("interface measures differ: solid {} vs fluid {} (interface_measure of the two sections)", a, b);
     }
     data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
-                         {"max_gap", map_.max_gap()}};
+                         {"max_gap", map_.max_gap()}, {"conforming", map_.conforming()},
+                         {"coincident_nodes", map_.coincident_nodes()}};
+    if (map_.conforming()) {
+      data["interface"]["permutation_error"] = map_.permutation_error();
+      log->info("conforming interface: the {} fluid nodes are the solid's (max gap {:.3g} m), H is a permutation "
+                "(max |H - P| {:.3g})", fluid_interface.nodes(), map_.max_gap(), map_.permutation_error());
+    } else {
+      log->info("non-conforming interface: {} of the {} fluid nodes coincide with one of the {} solid nodes "
+                "(within {:.3g} m), max gap to the solid's interface {:.3g} m: H interpolates",
+                map_.coincident_nodes(), fluid_interface.nodes(), ns, map_.coincidence_tolerance(), map_.max_gap());
+    }
     consistent_damping_ = implicit && gamma > 0 && settings_.robin_mass == RobinMass::Consistent;
     if (consistent_damping_ && !solid_.supports_interface_mass()) {
       consistent_damping_ = false;

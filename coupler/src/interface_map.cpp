@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -56,6 +58,38 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
   hs_.resize(nf, ns);
   hs_.setFromTriplets(ts.begin(), ts.end());
   hst_ = hs_.transpose();
+
+  // Conforming? The nearest solid node of every fluid node (detection only: H stays the
+  // projection above, which for coinciding nodes is P to round-off).
+  Eigen::Vector2d lo = solid.coordinates.colwise().minCoeff().transpose();
+  Eigen::Vector2d hi = solid.coordinates.colwise().maxCoeff().transpose();
+  lo = lo.cwiseMin(fluid.coordinates.colwise().minCoeff().transpose());
+  hi = hi.cwiseMax(fluid.coordinates.colwise().maxCoeff().transpose());
+  tolerance_ = 1e-9 * (hi - lo).norm();
+  std::vector<Eigen::Index> match(static_cast<std::size_t>(nf), -1);
+  std::vector<char> taken(static_cast<std::size_t>(ns), 0);
+  bool distinct = true;
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Index k = -1;
+    for (Eigen::Index j = 0; j < ns; ++j) {
+      const double dist = (solid.coordinates.row(j) - fluid.coordinates.row(i)).norm();
+      if (dist < best) best = dist, k = j;
+    }
+    if (best > tolerance_) continue;
+    ++coincident_nodes_;
+    match[static_cast<std::size_t>(i)] = k;
+    if (taken[static_cast<std::size_t>(k)]) distinct = false;
+    taken[static_cast<std::size_t>(k)] = 1;
+  }
+  conforming_ = nf == ns && coincident_nodes_ == nf && distinct;
+  if (conforming_) {
+    for (int col = 0; col < hs_.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(hs_, col); it; ++it) {
+        const double p = match[static_cast<std::size_t>(it.row())] == it.col() ? 1.0 : 0.0;
+        permutation_error_ = std::max(permutation_error_, std::abs(it.value() - p));
+      }
+  }
 }
 
 NodalMatrix InterfaceMap::mass_to_solid(const NodalMatrix& fluid_mass) const {

@@ -92,4 +92,45 @@ TEST(InterfaceMap, MissingInterfaceOnOneSideIsAnError) {
   EXPECT_THROW(fsi::coupling::InterfaceMap(polyline(3, 0, 1, 0), empty), std::invalid_argument);
 }
 
+// Conforming interface: the same nodes in another order (the fluid's node numbering) is a
+// permutation; a node 2e-7 off (the Turek-Hron flag root, solid origin 0.24899 vs the
+// cylinder's 0.2489898) or extra midpoints (the P2 fluid) is not.
+TEST(InterfaceMap, DetectsConformingInterfaces) {
+  const auto s = polyline(9, 0.25, 0.6, 0.19);
+  fsi::InterfaceMeshData f = s;
+  for (int i = 0; i < 9; ++i) f.coordinates.row(i) = s.coordinates.row((5 * i + 2) % 9);  // a permutation
+  {
+    fsi::coupling::InterfaceMap map(s, f);
+    EXPECT_TRUE(map.conforming());
+    EXPECT_EQ(map.coincident_nodes(), 9);
+    EXPECT_LT(map.max_gap(), 1e-15);
+    EXPECT_LT(map.permutation_error(), 1e-12);
+    Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(18, -1, 3);
+    const Eigen::VectorXd vf = map.to_fluid(v);
+    for (int i = 0; i < 9; ++i) EXPECT_NEAR(vf[2 * i + 1], v[2 * ((5 * i + 2) % 9) + 1], 1e-12);
+  }
+  {
+    fsi::InterfaceMeshData g = f;
+    g.coordinates(0, 0) += 1e-10;  // within 1e-9 of the size (0.35): still the same node
+    EXPECT_TRUE(fsi::coupling::InterfaceMap(s, g).conforming());
+    g.coordinates(0, 0) += 2e-7;
+    fsi::coupling::InterfaceMap map(s, g);
+    EXPECT_FALSE(map.conforming());
+    EXPECT_EQ(map.coincident_nodes(), 8);
+    EXPECT_DOUBLE_EQ(map.permutation_error(), 0.0);
+  }
+  {
+    const auto p2 = polyline(17, 0.25, 0.6, 0.19);  // vertices and midpoints
+    fsi::coupling::InterfaceMap map(s, p2);
+    EXPECT_FALSE(map.conforming());
+    EXPECT_EQ(map.coincident_nodes(), 9);
+    EXPECT_LT(map.max_gap(), 1e-15);
+  }
+  {
+    fsi::InterfaceMeshData twice = f;  // as many nodes, but two on the same solid node
+    twice.coordinates.row(1) = twice.coordinates.row(0);
+    EXPECT_FALSE(fsi::coupling::InterfaceMap(s, twice).conforming());
+  }
+}
+
 }  // namespace

@@ -5,6 +5,10 @@
 //  - forces: the transpose, F_s = H^T f_f (conservative), so that the power across the
 //    interface is the same on both sides: F_s . v_s = f_f . v_f exactly.
 // A point interface (no segments) maps node to nearest node.
+// Conforming interface: as many fluid as solid nodes, and every fluid node within
+// 1e-9 of the interface's size (the diagonal of the box around both node sets) of a
+// different solid node; H is then a permutation P (to round-off: its rows are the
+// projections on the solid polyline, within gap / segment length of P's unit rows).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -25,11 +29,21 @@ class InterfaceMap {
   // for v_f = H v_s.
   NodalMatrix mass_to_solid(const NodalMatrix& fluid_mass) const;
   double max_gap() const { return max_gap_; }  // largest fluid-node-to-solid distance
+  bool conforming() const { return conforming_; }
+  // Fluid nodes that coincide (within coincidence_tolerance) with a solid node.
+  Eigen::Index coincident_nodes() const { return coincident_nodes_; }
+  double coincidence_tolerance() const { return tolerance_; }
+  // max |H - P| over the entries of the scalar H, P the permutation; 0 unless conforming.
+  double permutation_error() const { return permutation_error_; }
 
  private:
   Eigen::SparseMatrix<double> h_, ht_;
   Eigen::SparseMatrix<double> hs_, hst_;  // the scalar (per node) H, n_f x n_s, and its transpose
   double max_gap_ = 0;
+  bool conforming_ = false;
+  Eigen::Index coincident_nodes_ = 0;
+  double tolerance_ = 0;
+  double permutation_error_ = 0;
 };
 
 // M_G = int N^T N dgamma on the solid interface (2n x 2n, consistent, current
