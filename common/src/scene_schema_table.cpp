@@ -209,7 +209,9 @@ std::vector<Key> fem_fluid_keys() {
                       .group("source"),
                   text("geo", "gmsh .geo, meshed once per parameter set into the mesh cache").group("source"),
                   number("size", "element size h far from the body").req().gt(0).only_when("geo").in_unit("m"),
-                  named_map("parameters", "further gmsh -setnumber values, name: number",
+                  named_map("parameters",
+                            "further gmsh -setnumber values, name: number (meshes/th_cylinder_flag.geo: hc, hw, "
+                            "algorithm, nflag and nflagt for a conforming flag; see its header)",
                             number("<name>", "value"))
                       .only_when("geo"),
                   text("cache_dir", "mesh cache; default $FSI_MESH_CACHE, else ~/.cache/fsi/meshes")
