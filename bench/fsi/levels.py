@@ -167,7 +167,8 @@ def cmd_table(a):
     for lv, r in rows.items():
         dt = BASE_DT[(a.case, a.element)] * LEVELS[lv]["dt"]
         nx, ny = LEVELS[lv]["solid"]
-        head = f"| {lv} | {r.get('unknowns') or '-'} | {nx} x {ny} | {dt:g} |"
+        unfinished = f" ({r['state']}, t = {r['t_end']:.4g})" if r.get("state") not in ("completed", "missing") else ""
+        head = f"| {lv}{unfinished} | {r.get('unknowns') or '-'} | {nx} x {ny} | {dt:g} |"
         if "errors" not in r:
             why = r.get("refused") or r["state"]
             lines.append(head + f" {why} |" + " |" * 5)
