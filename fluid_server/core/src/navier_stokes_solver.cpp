@@ -223,6 +223,9 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
   if (!steady) mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
 
   Eigen::VectorXd U_adv = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
+  // A later coupling iteration of the step starts its linear solve from the last iterate's
+  // solution (closer than the extrapolation; the system solved is the same).
+  const bool retrial = trial_solves_ > 0 && U_.size() == U_adv.size();
   if (params_.relinearise && trial_solves_ > 0) U_adv = U_;  // a coupling iteration: about the last iterate
   ++trial_solves_;
   Eigen::VectorXd history = Eigen::VectorXd::Zero(ndof);
@@ -386,7 +389,7 @@ StepReport NavierStokesSolver::solve(double time, double dt, const Eigen::Matrix
     report.assembly_seconds += seconds_since(t_assembly);
 
     const Eigen::VectorXd U_new =
-        impl_->lu->solve(A, rhs, U_adv, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
+        impl_->lu->solve(A, rhs, retrial ? U_ : U_adv, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
                        steady ? 0.0 : alpha0 / dt);
 
     report.change = detail::relative_velocity_change(U_new, U_adv, n, [](int i, int c) { return 3 * i + c; });

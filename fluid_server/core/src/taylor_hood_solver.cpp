@@ -234,6 +234,9 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
   Eigen::MatrixX2d mesh_velocity = Eigen::MatrixX2d::Zero(n, 2);
   if (!steady) mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
   Eigen::VectorXd U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
+  // A later coupling iteration of the step starts its linear solve from the last iterate's
+  // solution (closer than the extrapolation; the system solved is the same).
+  const bool retrial = trial_solves_ > 0 && U_.size() == U_lin.size();
   if (params_.relinearise && trial_solves_ > 0) U_lin = U_;  // a coupling iteration: about the last iterate
   ++trial_solves_;
   Eigen::VectorXd history = Eigen::VectorXd::Zero(ndof);
@@ -374,7 +377,7 @@ StepReport TaylorHoodSolver::solve(double time, double dt, const Eigen::MatrixX2
 
     im.last_rhs = rhs;
     Eigen::VectorXd U_new =
-        im.lu->solve(A, rhs, U_lin, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
+        im.lu->solve(A, rhs, retrial ? U_ : U_lin, report, fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
                        steady ? 0.0 : alpha0 / dt);
 
     double change = detail::relative_velocity_change(U_new, U_lin, n, [](int i, int c) { return 2 * i + c; });
