@@ -76,434 +76,154 @@ NodalMatrix Coupler::physical_mass(const Eigen::VectorXd& solid_displacement, co
   return nodal_interface_mass(solid_interface_, solid_displacement);  // a fluid without M_f: the solid's polyline
 }
 
+// ---------------------------------------------------------------------------------------
+// The run's parts. run() reads as: configure, describe, start state, open tables, then the
+// time loop.
+
+// What carries from one accepted step to the next, and what a checkpoint saves of the
+// coupler (with the accelerator's reused secant pairs and the iteration count).
+struct Coupler::State {
+  Eigen::VectorXd force_n, force_nm1;  // F_n and F_{n-1} (the predictor)
+  // The accepted interface state: the solid's displacement and velocity (the velocity
+  // measure's k = 1 reference), the fluid's displacement.
+  Eigen::VectorXd d_s_prev, v_s_prev, d_f_prev;
+  // Work done across the interface, on each side: by the load the solid was actually
+  // given, and by the fluid's traction on the fluid's interface motion. With the
+  // transpose mapping they differ only by the partitioned scheme's lag and relaxation.
+  double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0, work_uncancelled = 0;
+  // M_G = H^T M_f H of the fluid's last solve (empty when the fluid does not send M_f).
+  NodalMatrix mapped_mass;
+};
+
+// One run: what it was configured with, its outputs and tables, checkpoints and State.
+struct Coupler::Run {
+  Run(const Coupler& c, const TimeSettings& time_settings, const InterfaceMeshData& fluid_interface,
+      RunOutcome& outcome, nlohmann::json& report_data, double start_time)
+      : out(outcome),
+        data(report_data),
+        log(logger("coupler")),
+        time(time_settings),
+        gamma(c.settings_.nitsche_penalty),
+        implicit(c.settings_.algorithm == Algorithm::ImplicitSolidVelocity),
+        ns(static_cast<Eigen::Index>(c.solid_interface_.nodes())),
+        vtk_dir(c.out_dir_ / "vtk"),
+        checkpoints(time.checkpoint_every > 0),
+        start(start_time),
+        accelerator(c.settings_),
+        parameters(scene_to_json(c.scene_)),
+        store(c.out_dir_ / "checkpoints", time.checkpoint_keep) {
+    // Output: both solvers' VTK and the coupling interfaces, every time.output_every steps
+    // and at t = 0.
+    if (time.output_every > 0) interface_output.emplace(vtk_dir, c.solid_interface_, fluid_interface);
+    const InterfaceMeshData& si = c.solid_interface_;
+    const Eigen::VectorXd d_s = si.initial_displacement.size() == 2 * ns ? si.initial_displacement
+                                                                          : Eigen::VectorXd::Zero(2 * ns);
+    const Eigen::VectorXd v_s = si.initial_velocity.size() == 2 * ns ? si.initial_velocity
+                                                                      : Eigen::VectorXd::Zero(2 * ns);
+    state.v_s_prev = v_s;
+    state.d_s_prev = d_s;
+    state.d_f_prev = c.map_.to_fluid(d_s);
+  }
+  RunOutcome& out;
+  nlohmann::json& data;
+  std::shared_ptr<spdlog::logger> log;
+  const TimeSettings time;
+  const double gamma;
+  const bool implicit;
+  const Eigen::Index ns;  // solid interface nodes
+  const std::filesystem::path vtk_dir;
+  const bool checkpoints;
+  const double start;  // wall clock at run()'s start
+  State state;
+  InterfaceAccelerator accelerator;
+  bool warned_no_fluid_mass = false;
+  // Output; a side that answers three requests without writing a file is named once (its
+  // section turns output off, or it cannot write any).
+  std::optional<InterfaceOutput> interface_output;
+  int output_requests = 0;
+  std::map<std::string, std::size_t> files_written{{"solid", 0}, {"fluid", 0}};
+  // Checkpoints, resume, fork.
+  const nlohmann::json parameters;
+  CheckpointStore store;
+  std::optional<CheckpointStore::Loaded> restart;
+  nlohmann::json fork;
+  int fork_step = 0;
+  long fork_iterations = 0;
+  bool at_fork = false;
+  double wall_before = 0;    // wall seconds of the run's earlier segments (resumed runs)
+  double segment_start = 0;  // wall clock when this segment's first step began
+  // Tables.
+  std::optional<ProbeTable> probes;
+  CsvWriter iterations, timing;
+  std::optional<Progress> progress;
+};
+
 RunOutcome Coupler::run(RunReport& report) {
-  auto log = logger("coupler");
   RunOutcome out;
   const double start = now();
-  double& solid_time = times_.solid;
-  double& fluid_time = times_.fluid;
-  double& coupler_time = times_.coupler;
-  auto& data = report.data();
   try {
     // 1. Read the scene's coupling part; configure both solvers.
-    scene_.name();
-    schema::require_valid(scene_, {"time", "coupling"});  // every key, before anything is configured
-    const TimeSettings time = read_time(scene_);
-    settings_ = read_coupling(scene_.section("coupling"));
-    scene_.check_all_used("coupling");
-    scene_.check_all_used("time");
-    for (const auto& key : scene_.root().keys())
-      if (key != "scene" && key != "description" && key != "time" && key != "coupling" && key != "solid" &&
-          key != "fluid")
-        throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
-                                      "coupling, solid, fluid)", scene_.root().where(key), key));
-    if (settings_.predictor == Predictor::Linear)
-      log->warn("predictor 'linear' (2 F_n - F_(n-1)) can excite interface modes the iterations leave "
-                "unconverged (docs/fsi.md); 'previous' is the paper's and the robust choice");
-    const double gamma = settings_.nitsche_penalty;
-    const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
-    if (implicit && gamma > 0 && !solid_.supports_interface_damping())
-      throw Stop{"failed", fmt::format("Algorithm 2 needs interface damping, which solid '{}' does not support",
-                                       solid_.name())};
-    const auto vtk_dir = out_dir_ / "vtk";
-    {
-      Timer t(solid_time);
-      solid_.configure(scene_.section("solid"), SolidSetup{time.dt, time.end, implicit ? gamma : 0.0,
-                                                           time.output_every > 0 ? vtk_dir : std::filesystem::path()});
-    }
-    {
-      Timer t(fluid_time);
-      fluid_.configure(scene_.section("fluid"),
-                       FluidSetup{time.dt, time.end, gamma, settings_.nitsche_symmetry,
-                                  time.output_every > 0 ? vtk_dir : std::filesystem::path()});
-    }
-    solid_interface_ = solid_.interface();
-    const InterfaceMeshData fluid_interface = fluid_.interface();
-    {
-      Timer t(coupler_time);
-      map_ = InterfaceMap(solid_interface_, fluid_interface);
-    }
-    const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
-    if (time.output_every > 0)
-      for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
-                                          std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
-        if (!ok) log->warn("time.output_every: the {} '{}' cannot write output (supports_output is false)", side, who);
-    // Point interfaces: both sides' measures (int N^T N) should agree, or the Robin terms
-    // weigh the two sides differently (in effect a damping of the wrong size or sign).
-    if (solid_interface_.segments.empty() && fluid_interface.segments.empty() &&
-        solid_interface_.lumped_measure.size() == fluid_interface.lumped_measure.size()) {
-      const double a = solid_interface_.lumped_measure.sum(), b = fluid_interface.lumped_measure.sum();
-      if (std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b)))
-        log->warn("interface measures differ: solid {} vs fluid {} (interface_measure of the two sections)", a, b);
-    }
-    data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
-                         {"max_gap", map_.max_gap()}, {"conforming", map_.conforming()},
-                         {"coincident_nodes", map_.coincident_nodes()}};
-    if (map_.conforming()) {
-      data["interface"]["permutation_error"] = map_.permutation_error();
-      log->info("conforming interface: the {} fluid nodes are the solid's (max gap {:.3g} m), H is a permutation "
-                "(max |H - P| {:.3g})", fluid_interface.nodes(), map_.max_gap(), map_.permutation_error());
-    } else {
-      log->info("non-conforming interface: {} of the {} fluid nodes coincide with one of the {} solid nodes "
-                "(within {:.3g} m), max gap to the solid's interface {:.3g} m: H interpolates",
-                map_.coincident_nodes(), fluid_interface.nodes(), ns, map_.coincidence_tolerance(), map_.max_gap());
-    }
-    consistent_damping_ = implicit && gamma > 0 && settings_.robin_mass == RobinMass::Consistent;
-    if (consistent_damping_ && !solid_.supports_interface_mass()) {
-      consistent_damping_ = false;
-      log->warn("the solid '{}' does not take the interface mass (supports_interface_mass): Algorithm 2's damping "
-                "uses its own int N^T N, and the gamma_N1 terms do not cancel exactly at convergence "
-                "(coupling.work_uncancelled in probes.csv)",
-                solid_.name());
-    }
-    data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
-                        {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
-                        {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
-                        {"acceleration", to_string(settings_.acceleration)},
-                        {"robin_mass", to_string(settings_.robin_mass)}};
-    {
-      nlohmann::json measures = nlohmann::json::array();
-      for (const auto& m : settings_.measures)
-        measures.push_back({{"name", m.name()}, {"limit", m.limit}, {"strict", m.strict}});
-      data["coupling"]["measures"] = measures;
-      data["coupling"]["combine"] = settings_.combine_all ? "all" : "any";
-    }
-    log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
-              to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
-              settings_.tolerance, ns, fluid_interface.nodes());
-
-    // 2. Initial state: the newest checkpoint (resume), or the scene's initial state and the
-    //    predictor's F_0 = -F*(initial fluid state).
-    const bool checkpoints = time.checkpoint_every > 0;
-    // Output: both solvers' VTK and the coupling interfaces, every time.output_every steps
-    // and at t = 0. A side that answers three requests without writing a file is named once
-    // (its section turns output off, or it cannot write any).
-    std::optional<InterfaceOutput> interface_output;
-    if (time.output_every > 0) interface_output.emplace(vtk_dir, solid_interface_, fluid_interface);
-    int output_requests = 0;
-    std::map<std::string, std::size_t> files_written{{"solid", 0}, {"fluid", 0}};
-    auto write_output = [&](const StepInfo& info, const InterfaceFields& fields) {
-      ++output_requests;
-      if (solid_.supports_output()) {
-        Timer t(solid_time);
-        files_written["solid"] += solid_.write_output(info).size();
-      }
-      if (fluid_.supports_output()) {
-        Timer t(fluid_time);
-        files_written["fluid"] += fluid_.write_output(info).size();
-      }
-      {
-        Timer t(coupler_time);
-        interface_output->write(info.time, info.step, fields);
-      }
-      if (output_requests == 3)
-        for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
-                                            std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
-          if (ok && files_written[side] == 0)
-            log->warn("time.output_every = {}: the {} '{}' wrote no VTK in {} requests (does its section turn "
-                      "output off? {})",
-                      time.output_every, side, who, output_requests,
-                      std::string(side) == "solid" ? "solid.output_every" : "fluid.output.vtk_every");
-    };
-    if (checkpoints || resume_)
-      for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_checkpoint(), solid_.name()},
-                                          std::tuple{"fluid", fluid_.supports_checkpoint(), fluid_.name()}})
-        if (!ok)
-          throw Stop{"failed", fmt::format("{} needs checkpoints, which the {} '{}' does not support",
-                                           resume_ ? "--resume" : "time.checkpoint_every", side, who)};
-    Eigen::VectorXd d_s = solid_interface_.initial_displacement.size() == 2 * ns
-                              ? solid_interface_.initial_displacement
-                              : Eigen::VectorXd::Zero(2 * ns);
-    Eigen::VectorXd v_s = solid_interface_.initial_velocity.size() == 2 * ns ? solid_interface_.initial_velocity
-                                                                              : Eigen::VectorXd::Zero(2 * ns);
-    Eigen::VectorXd force_n, force_nm1;
-    // Work done across the interface, on each side: by the load the solid was actually
-    // given, and by the fluid's traction on the fluid's interface motion. With the
-    // transpose mapping they differ only by the partitioned scheme's lag and relaxation.
-    double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0, work_uncancelled = 0;
-    // M_G = H^T M_f H of the fluid's last solve (empty when the fluid does not send M_f).
-    NodalMatrix mapped_mass;
-    bool warned_no_fluid_mass = false;
-    auto map_mass = [&](const FluidLoads& loads) {
-      if (loads.interface_mass.rows() == 0) {
-        if (!warned_no_fluid_mass && gamma > 0 && settings_.robin_mass == RobinMass::Consistent)
-          log->warn("the fluid '{}' does not send its interface mass M_f: the gamma_N1 terms use the solid's "
-                    "polyline int N^T N and cancel at convergence only where it equals H^T M_f H",
-                    fluid_.name());
-        warned_no_fluid_mass = true;
-        return NodalMatrix();
-      }
-      try {
-        return map_.mass_to_solid(loads.interface_mass);
-      } catch (const std::invalid_argument& e) {
-        throw Stop{"failed", fmt::format("fluid '{}': {}", fluid_.name(), e.what())};
-      }
-    };
-    // The velocity the accepted state ended with (the velocity measure's k = 1 reference).
-    Eigen::VectorXd v_s_prev = v_s;
-    Eigen::VectorXd d_s_prev = d_s, d_f_prev = map_.to_fluid(d_s);
-    InterfaceAccelerator accelerator(settings_);
-    const nlohmann::json parameters = scene_to_json(scene_);
-    CheckpointStore store(out_dir_ / "checkpoints", time.checkpoint_keep);
-    std::optional<CheckpointStore::Loaded> restart;
-    double wall_before = 0;  // wall seconds of the run's earlier segments (resumed runs)
-    if (resume_) {
-      std::vector<std::string> skipped;
-      restart = store.newest(&skipped);
-      for (const auto& why : skipped) log->warn("skipping checkpoint {}", why);
-      if (!restart && !allow_fresh_start_)
-        throw Stop{"failed", fmt::format("--resume: no complete checkpoint in {}{}", (out_dir_ / "checkpoints").string(),
-                                         skipped.empty() ? std::string() : " (" + skipped.front() + ")")};
-      if (!restart) log->warn("no complete checkpoint yet: starting again from step 0");
-    }
-    // A forked run (fsi run --from): OUT/forked_from.json names the checkpoint it started from;
-    // at that checkpoint the scene may differ (the changes are listed in summary.json), and
-    // its probes.csv and iterations.csv hold only the steps after it.
-    nlohmann::json fork;
-    if (std::filesystem::exists(out_dir_ / "forked_from.json")) {
-      try {
-        std::ifstream in(out_dir_ / "forked_from.json");
-        fork = nlohmann::json::parse(in);
-      } catch (const std::exception& e) {
-        throw Stop{"failed", fmt::format("{}: does not parse ({})", (out_dir_ / "forked_from.json").string(), e.what())};
-      }
-      data["forked_from"] = fork;
-    }
-    const int fork_step = fork.is_object() ? fork.value("step", 0) : 0;
-    const long fork_iterations = fork.is_object() ? fork.value("iterations", 0L) : 0L;
-    const bool at_fork = fork.is_object() && restart && restart->step == fork_step;
-    if (restart) {
-      const int step = restart->step;
-      const auto diffs = parameter_differences(restart->manifest.value("parameters", nlohmann::json::object()), parameters);
-      if (at_fork) {
-        data["forked_from"]["changed"] = diffs;
-        for (const auto& d : diffs) log->info("forked with {}", d);
-      } else if (!diffs.empty()) {
-        std::string list;
-        for (const auto& d : diffs) list += "\n  " + d;
-        throw Stop{"failed", fmt::format("--resume: the scene differs from the one checkpoint {} was written with "
-                                         "({} key(s)):{}",
-                                         restart->dir.string(), diffs.size(), list)};
-      }
-      for (const char* part : {"solid", "fluid", "coupler"})
-        if (!restart->parts.count(part))
-          throw Stop{"failed", fmt::format("checkpoint {} has no '{}' part", restart->dir.string(), part)};
-      log->info("resuming from the checkpoint of step {} (t = {}) in {}", step, restart->time, restart->dir.string());
-      {
-        Timer t(solid_time);
-        solid_.load_checkpoint(step, restart->time, restart->parts.at("solid"));
-      }
-      {
-        Timer t(fluid_time);
-        fluid_.load_checkpoint(step, restart->time, restart->parts.at("fluid"));
-      }
-      const StateArchive c = StateArchive::parse(restart->parts.at("coupler"), "coupler checkpoint of step " +
-                                                                                    std::to_string(step));
-      if (c.integer("step") != step)
-        throw Stop{"failed", fmt::format("checkpoint {}: coupler part is of step {}", restart->dir.string(), c.integer("step"))};
-      force_n = c.vector("force_n", 2 * ns);
-      force_nm1 = c.vector("force_nm1", 2 * ns);
-      d_s_prev = c.vector("d_s_prev", 2 * ns);
-      d_f_prev = c.vector("d_f_prev", d_f_prev.size());
-      if (c.has("v_s_prev")) v_s_prev = c.vector("v_s_prev", 2 * ns);
-      if (c.has("work_uncancelled")) work_uncancelled = c.real("work_uncancelled");
-      if (c.has("mapped_mass.values")) {
-        const Eigen::VectorXd rows = c.vector("mapped_mass.rows"), cols = c.vector("mapped_mass.cols"),
-                              values = c.vector("mapped_mass.values");
-        if (rows.size() != values.size() || cols.size() != values.size())
-          throw Stop{"failed", fmt::format("checkpoint {}: coupler part has a malformed mapped_mass", restart->dir.string())};
-        std::vector<Eigen::Triplet<double>> t;
-        for (Eigen::Index k = 0; k < values.size(); ++k) {
-          const auto r = static_cast<Eigen::Index>(rows[k]), col = static_cast<Eigen::Index>(cols[k]);
-          if (r < 0 || r >= ns || col < 0 || col >= ns)
-            throw Stop{"failed", fmt::format("checkpoint {}: coupler mapped_mass entry ({}, {}) outside {} nodes",
-                                             restart->dir.string(), r, col, ns)};
-          t.emplace_back(r, col, values[k]);
-        }
-        mapped_mass.resize(ns, ns);
-        mapped_mass.setFromTriplets(t.begin(), t.end());
-      } else if (implicit && gamma > 0) {
-        log->warn("checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
-                  "solid's own int N^T N", restart->dir.string(), step + 1);
-      }
-      work_solid = c.real("work_solid");
-      work_fluid = c.real("work_fluid");
-      work_fluid_on_solid = c.real("work_fluid_on_solid");
-      out.iterations = static_cast<long>(c.integer("iterations"));
-      accelerator.load(c, "accelerator.");
-      if (at_fork) {
-        // F_n holds the algorithm's own Robin part: Algorithm 2's force is the load the solid
-        // felt plus gamma_N1 C v_n. Forked into another algorithm or gamma_N1, convert it (the
-        // predictor of the next step), and drop the accelerator's reused secant pairs (they
-        // live in the old force's space).
-        const auto& old = restart->manifest.value("parameters", nlohmann::json::object()).value("coupling", nlohmann::json::object());
-        auto number = [](const nlohmann::json& j, const char* key, double fallback) {
-          if (!j.contains(key)) return fallback;
-          const auto& v = j.at(key);
-          return v.is_number() ? v.get<double>() : v.is_string() ? std::stod(v.get<std::string>()) : fallback;
-        };
-        const int old_algorithm = static_cast<int>(number(old, "algorithm", static_cast<double>(settings_.algorithm)));
-        const double old_gamma = number(old, "gamma_n1", gamma);
-        if (old_algorithm != static_cast<int>(settings_.algorithm) || old_gamma != gamma) {
-          const NodalMatrix c_mass = mapped_mass.rows() > 0 ? mapped_mass : nodal_interface_mass(solid_interface_, {});
-          if (!c.has("v_s_prev"))
-            log->warn("checkpoint {} holds no interface velocity (an earlier version): the first step's predictor "
-                      "keeps the old algorithm's force", restart->dir.string());
-          else {
-            for (Eigen::VectorXd* f : {&force_n, &force_nm1}) {
-              if (old_algorithm == 2 && old_gamma > 0) *f -= old_gamma * apply_nodal(c_mass, v_s_prev);
-              if (implicit && gamma > 0) *f += gamma * apply_nodal(c_mass, v_s_prev);
-            }
-            data["forked_from"]["predictor_converted"] = true;
-          }
-          accelerator = InterfaceAccelerator(settings_);
-          log->info("forked from algorithm {} (gamma_N1 {}) into algorithm {} (gamma_N1 {}): the force predictor "
-                    "converted, the reused secant pairs dropped",
-                    old_algorithm, old_gamma, static_cast<int>(settings_.algorithm), gamma);
-        }
-      }
-      wall_before = restart->manifest.value("wall_seconds", 0.0);
-      out.steps = step;
-      out.resumed_from = step;
-    } else {
-      FluidLoads loads;
-      {
-        Timer t(fluid_time);
-        loads = fluid_.initial_loads(map_.to_fluid(d_s), map_.to_fluid(v_s));
-      }
-      Timer t(coupler_time);
-      mapped_mass = map_mass(loads);
-      force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s,
-                             mapped_mass);
-      force_nm1 = force_n;
-      if (time.output_every > 0) {  // the initial state, t = 0
-        write_output(StepInfo{0.0, time.dt, 0, 0},
-                     InterfaceFields{d_s, v_s, force_n, map_.to_solid(loads.traction_force),
-                                     map_.to_solid(loads.velocity_integral), map_.to_fluid(d_s), map_.to_fluid(v_s),
-                                     loads.traction_force, loads.velocity_integral});
-      }
-    }
-    if (checkpoints)
-      data["checkpoints"] = {{"every", time.checkpoint_every}, {"keep", time.checkpoint_keep}, {"written", 0},
-                             {"seconds", 0.0}, {"folder", (out_dir_ / "checkpoints").string()}};
-    if (restart) data["resumed_from_step"] = restart->step;
-    data["wall_time_earlier_segments"] = wall_before;
-
+    InterfaceMeshData fluid_interface;
+    const TimeSettings time = configure(fluid_interface);
+    describe_setup(report.data(), time, fluid_interface);
+    // 2. Initial state: the newest checkpoint (resume, fork), or the scene's initial state
+    //    and the predictor's F_0 = -F*(initial fluid state).
+    Run r(*this, time, fluid_interface, out, report.data(), start);
+    start_state(r);
     // 3. Time loop.
-    std::vector<std::string> iteration_columns{"step",          "time",          "iteration",         "residual",
-                                               "force_norm",    "solid_newton",  "fluid_iterations",  "traction_change",
-                                               "traction_norm", "displacement_change", "displacement_norm",
-                                               "velocity_change", "velocity_norm"};
-    for (const auto& m : settings_.measures) iteration_columns.push_back(m.name());
-    const bool resume_tables = restart && !at_fork;
-    ProbeTable probes = resume_tables ? ProbeTable::resume(out_dir_ / "probes.csv",
-                                                           static_cast<std::size_t>(restart->step - fork_step))
-                                      : ProbeTable(out_dir_ / "probes.csv");
-    CsvWriter iterations =
-        resume_tables ? CsvWriter::resume(out_dir_ / "iterations.csv",
-                                          static_cast<std::size_t>(out.iterations - fork_iterations), iteration_columns)
-                      : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
-    // Wall time per step (not byte-identical across runs, so apart from probes.csv): cumulative
-    // seconds of the run, its fluid and solid requests, for cost per simulated second.
-    const std::vector<std::string> timing_columns{"step", "time", "wall", "fluid", "solid", "iterations"};
-    const auto timing_path = out_dir_ / "timing.csv";
-    CsvWriter timing = resume_tables && std::filesystem::exists(timing_path)
-                           ? CsvWriter::resume(timing_path, static_cast<std::size_t>(restart->step - fork_step),
-                                               timing_columns)
-                           : CsvWriter(timing_path, timing_columns);
-    Progress progress("coupler", time.steps, out.steps);
-    const double segment_start = now();
-    auto save_checkpoint = [&](int n, double t_np1) {
-      Timer t(times_.checkpoint);
-      std::map<std::string, std::string> parts;
-      parts["solid"] = solid_.save_checkpoint(n, t_np1);
-      parts["fluid"] = fluid_.save_checkpoint(n, t_np1);
-      StateArchive c;
-      c.put("step", static_cast<std::int64_t>(n));
-      c.put("force_n", force_n);
-      c.put("force_nm1", force_nm1);
-      c.put("d_s_prev", d_s_prev);
-      c.put("d_f_prev", d_f_prev);
-      c.put("work_solid", work_solid);
-      c.put("work_fluid", work_fluid);
-      c.put("work_fluid_on_solid", work_fluid_on_solid);
-      c.put("work_uncancelled", work_uncancelled);
-      c.put("v_s_prev", v_s_prev);
-      if (mapped_mass.rows() > 0) {
-        std::vector<double> rows, cols, values;
-        for (int col = 0; col < mapped_mass.outerSize(); ++col)
-          for (NodalMatrix::InnerIterator it(mapped_mass, col); it; ++it)
-            rows.push_back(double(it.row())), cols.push_back(double(it.col())), values.push_back(it.value());
-        c.put("mapped_mass.rows", rows);
-        c.put("mapped_mass.cols", cols);
-        c.put("mapped_mass.values", values);
-      }
-      c.put("iterations", static_cast<std::int64_t>(out.iterations));
-      accelerator.save(c, "accelerator.");
-      parts["coupler"] = c.serialize();
-      nlohmann::json manifest = {{"scene", data.value("scene", std::string())},
-                                 {"scene_file", scene_.origin()},
-                                 {"overrides", scene_.overrides()},
-                                 {"parameters", parameters},
-                                 {"iterations", out.iterations},
-                                 {"wall_seconds", wall_before + (now() - segment_start)}};
-      const auto written = store.write(n, t_np1, manifest, parts);
-      auto& info = data["checkpoints"];
-      info["written"] = info.value("written", 0) + 1;
-      info["last_step"] = n;
-      info["last_bytes"] = written.bytes;
-      info["parts_bytes"] = {{"solid", parts["solid"].size()}, {"fluid", parts["fluid"].size()},
-                             {"coupler", parts["coupler"].size()}};
-    };
+    open_tables(r);
+    State& st = r.state;
+    const double gamma = r.gamma;
+    const bool implicit = r.implicit;
     for (int n = out.steps + 1; n <= time.steps; ++n) {
       const double t_np1 = n * time.dt;
-      Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * force_n - force_nm1)
-                                                                               : force_n;
+      Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * st.force_n - st.force_nm1)
+                                                                               : st.force_n;
       double first_residual = 0, residual = 0, first_change = 0;
       const std::size_t n_measures = settings_.measures.size();
       bool converged = n_measures == 0;
       std::vector<double> first_r(n_measures, 0.0), values(n_measures, 0.0);
       int k = 1;
-      accelerator.begin_step();
+      r.accelerator.begin_step();
       SolidStepResult s_last;
       FluidLoads loads_last;
       Eigen::VectorXd force_applied, d_f_last, traction_last;
       NodalMatrix damping_last, mass_last;
-      Eigen::VectorXd d_iter_prev = d_s_prev, v_iter_prev = v_s_prev;
+      Eigen::VectorXd d_iter_prev = st.d_s_prev, v_iter_prev = st.v_s_prev;
       for (; k <= settings_.max_iterations; ++k) {
         if (interrupt_flag())
           throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
         const StepInfo info{t_np1, time.dt, n, k};
         // Algorithm 2: the damping operator of this solve: H^T M_f H of the fluid's last solve
         // (consistent), or the solid's own int N^T N.
-        const NodalMatrix damping = solid_damping_mass(mapped_mass);
-        if (consistent_damping_ && mapped_mass.rows() > 0) {
-          Timer t(solid_time);
+        const NodalMatrix damping = solid_damping_mass(st.mapped_mass);
+        if (consistent_damping_ && st.mapped_mass.rows() > 0) {
+          Timer t(times_.solid);
           solid_.set_interface_mass(damping);
         }
         SolidStepResult s;
         {
-          Timer t(solid_time);
+          Timer t(times_.solid);
           s = solid_.solve_step(info, force);
         }
         if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
           throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
         Eigen::VectorXd d_f, v_f;
         {
-          Timer t(coupler_time);
+          Timer t(times_.coupler);
           d_f = map_.to_fluid(s.interface_displacement);
           v_f = map_.to_fluid(s.interface_velocity);
         }
         FluidLoads loads;
         {
-          Timer t(fluid_time);
+          Timer t(times_.fluid);
           loads = fluid_.solve_step(info, d_f, v_f);
         }
         Eigen::VectorXd relaxed, traction, traction_change;
         NodalMatrix mass_k;
         {
-          Timer t(coupler_time);
-          mass_k = map_mass(loads);
+          Timer t(times_.coupler);
+          mass_k = map_mass(r, loads);
           const Eigen::VectorXd fs = map_.to_solid(loads.traction_force), fv = map_.to_solid(loads.velocity_integral);
           const Eigen::VectorXd f_star = robin_force(fs, fv, s.interface_velocity, s.interface_displacement, mass_k);
           // The physical traction H^T R = f_sigma - gamma (f_v - M_f v_s) (the fluid's reaction,
@@ -516,8 +236,8 @@ RunOutcome Coupler::run(RunReport& report) {
           if (damping.rows() > 0) traction_change -= gamma * apply_nodal(damping, s.interface_velocity);
           // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
           // (acceleration.hpp for Aitken and IQN-ILS).
-          relaxed = accelerator.update(force, -f_star - force);
-          mapped_mass = mass_k;  // the next solid solve's damping (Algorithm 2)
+          relaxed = r.accelerator.update(force, -f_star - force);
+          st.mapped_mass = mass_k;  // the next solid solve's damping (Algorithm 2)
         }
         if (!all_finite(relaxed))
           throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
@@ -550,7 +270,7 @@ RunOutcome Coupler::run(RunReport& report) {
                                        r_quantity[1],    q_quantity[1],   r_quantity[2],    q_quantity[2],
                                        r_quantity[3],    q_quantity[3]};
         row_values.insert(row_values.end(), values.begin(), values.end());
-        iterations.row(row_values);
+        r.iterations.row(row_values);
         force_applied = force;
         s_last = s;
         loads_last = loads;
@@ -602,26 +322,26 @@ RunOutcome Coupler::run(RunReport& report) {
       const StepInfo accepted{t_np1, time.dt, n, used};
       std::map<std::string, double> row;
       {
-        Timer t(solid_time);
+        Timer t(times_.solid);
         for (const auto& [name, v] : solid_.accept_step(accepted)) row["solid." + name] = v;
       }
       {
-        Timer t(fluid_time);
+        Timer t(times_.fluid);
         for (const auto& [name, v] : fluid_.accept_step(accepted)) row["fluid." + name] = v;
       }
       {
-        Timer t(coupler_time);
-        work_solid += force_applied.dot(s_last.interface_displacement - d_s_prev);
-        work_fluid -= loads_last.traction_force.dot(d_f_last - d_f_prev);
+        Timer t(times_.coupler);
+        st.work_solid += force_applied.dot(s_last.interface_displacement - st.d_s_prev);
+        st.work_fluid -= loads_last.traction_force.dot(d_f_last - st.d_f_prev);
         // The same work evaluated on the solid's nodes through the transpose mapping:
         // identical up to round-off (the mapping neither creates nor destroys energy).
-        work_fluid_on_solid -= map_.to_solid(loads_last.traction_force).dot(s_last.interface_displacement - d_s_prev);
+        st.work_fluid_on_solid -= map_.to_solid(loads_last.traction_force).dot(s_last.interface_displacement - st.d_s_prev);
         // The interface power balance of the step (average over dt): the coupling load in the
         // solid's equation (its force and its own Robin damping), the physical traction of the
         // fluid, and the part of the gamma_N1 terms that would remain at exact convergence,
         // gamma (H^T M_f H - C) v_s with both operators in the accepted configuration (zero
         // when the solid's operator is the fluid's, robin_mass: consistent).
-        const Eigen::VectorXd dd = s_last.interface_displacement - d_s_prev;
+        const Eigen::VectorXd dd = s_last.interface_displacement - st.d_s_prev;
         const Eigen::VectorXd& v = s_last.interface_velocity;
         Eigen::VectorXd load = force_applied;
         if (damping_last.rows() > 0) load -= gamma * apply_nodal(damping_last, v);
@@ -632,47 +352,47 @@ RunOutcome Coupler::run(RunReport& report) {
                                              : algorithm1_mass(s_last.interface_displacement, mass_last);
           uncancelled = gamma * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
         }
-        work_uncancelled += uncancelled;
+        st.work_uncancelled += uncancelled;
         row["coupling.power_solid"] = load.dot(dd) / time.dt;
         row["coupling.power_fluid"] = -traction_last.dot(dd) / time.dt;
         row["coupling.power_uncancelled"] = uncancelled / time.dt;
-        row["coupling.work_uncancelled"] = work_uncancelled;
+        row["coupling.work_uncancelled"] = st.work_uncancelled;
         Eigen::Vector2d total = Eigen::Vector2d::Zero();
-        for (Eigen::Index i = 0; i < ns; ++i) total -= traction_last.segment<2>(2 * i);
+        for (Eigen::Index i = 0; i < r.ns; ++i) total -= traction_last.segment<2>(2 * i);
         row["coupling.solid_force_x"] = total(0);
         row["coupling.solid_force_y"] = total(1);
-        d_s_prev = s_last.interface_displacement;
-        v_s_prev = s_last.interface_velocity;
-        d_f_prev = d_f_last;
+        st.d_s_prev = s_last.interface_displacement;
+        st.v_s_prev = s_last.interface_velocity;
+        st.d_f_prev = d_f_last;
       }
       row["coupling.iterations"] = used;
       row["coupling.residual"] = residual;
-      row["coupling.work_solid"] = work_solid;
-      row["coupling.work_fluid"] = work_fluid;
-      row["coupling.work_mapping_error"] = std::abs(work_fluid - work_fluid_on_solid);
+      row["coupling.work_solid"] = st.work_solid;
+      row["coupling.work_fluid"] = st.work_fluid;
+      row["coupling.work_mapping_error"] = std::abs(st.work_fluid - st.work_fluid_on_solid);
       for (const auto& [name, v] : row)
         if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
-      probes.add(t_np1, row);
+      r.probes->add(t_np1, row);
       // before the checkpoint of this step, so a checkpoint never has fewer timing rows than steps
-      timing.row(std::vector<double>{double(n), t_np1, wall_before + (now() - segment_start), fluid_time, solid_time,
+      r.timing.row(std::vector<double>{double(n), t_np1, r.wall_before + (now() - r.segment_start), times_.fluid, times_.solid,
                                      double(used)});
       if (time.output_every > 0 && n % time.output_every == 0)
-        write_output(accepted, InterfaceFields{s_last.interface_displacement, s_last.interface_velocity, force_applied,
+        write_output(r, accepted, InterfaceFields{s_last.interface_displacement, s_last.interface_velocity, force_applied,
                                                map_.to_solid(loads_last.traction_force),
                                                map_.to_solid(loads_last.velocity_integral), d_f_last,
                                                map_.to_fluid(s_last.interface_velocity), loads_last.traction_force,
                                                loads_last.velocity_integral});
-      accelerator.end_step();
-      force_nm1 = force_n;
-      force_n = force;
+      r.accelerator.end_step();
+      st.force_nm1 = st.force_n;
+      st.force_n = force;
       out.steps = n;
-      if (checkpoints && n % time.checkpoint_every == 0 && n < time.steps) {
-        save_checkpoint(n, t_np1);
-        data["checkpoints"]["seconds"] = times_.checkpoint;
+      if (r.checkpoints && n % time.checkpoint_every == 0 && n < time.steps) {
+        save_checkpoint(r, n, t_np1);
+        r.data["checkpoints"]["seconds"] = times_.checkpoint;
       }
-      times_.total = now() - start;
+      times_.total = now() - r.start;
       if (on_step) on_step(out);
-      progress.update(n, t_np1, fmt::format("iterations {} residual {:.2e}", used, residual));
+      r.progress->update(n, t_np1, fmt::format("iterations {} residual {:.2e}", used, residual));
     }
     out.status = "completed";
   } catch (const Stop& stop) {
@@ -690,6 +410,382 @@ RunOutcome Coupler::run(RunReport& report) {
   }
   times_.total = now() - start;
   return out;
+}
+
+TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
+  auto log = logger("coupler");
+  scene_.name();
+  schema::require_valid(scene_, {"time", "coupling"});  // every key, before anything is configured
+  const TimeSettings time = read_time(scene_);
+  settings_ = read_coupling(scene_.section("coupling"));
+  scene_.check_all_used("coupling");
+  scene_.check_all_used("time");
+  for (const auto& key : scene_.root().keys())
+    if (key != "scene" && key != "description" && key != "time" && key != "coupling" && key != "solid" &&
+        key != "fluid")
+      throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
+                                    "coupling, solid, fluid)", scene_.root().where(key), key));
+  if (settings_.predictor == Predictor::Linear)
+    log->warn("predictor 'linear' (2 F_n - F_(n-1)) can excite interface modes the iterations leave "
+              "unconverged (docs/fsi.md); 'previous' is the paper's and the robust choice");
+  const double gamma = settings_.nitsche_penalty;
+  const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
+  if (implicit && gamma > 0 && !solid_.supports_interface_damping())
+    throw Stop{"failed", fmt::format("Algorithm 2 needs interface damping, which solid '{}' does not support",
+                                     solid_.name())};
+  const auto vtk_dir = out_dir_ / "vtk";
+  {
+    Timer t(times_.solid);
+    solid_.configure(scene_.section("solid"), SolidSetup{time.dt, time.end, implicit ? gamma : 0.0,
+                                                         time.output_every > 0 ? vtk_dir : std::filesystem::path()});
+  }
+  {
+    Timer t(times_.fluid);
+    fluid_.configure(scene_.section("fluid"),
+                     FluidSetup{time.dt, time.end, gamma, settings_.nitsche_symmetry,
+                                time.output_every > 0 ? vtk_dir : std::filesystem::path()});
+  }
+  solid_interface_ = solid_.interface();
+  fluid_interface = fluid_.interface();
+  {
+    Timer t(times_.coupler);
+    map_ = InterfaceMap(solid_interface_, fluid_interface);
+  }
+  return time;
+}
+
+void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface) {
+  auto log = logger("coupler");
+  const double gamma = settings_.nitsche_penalty;
+  const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
+  const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
+  if (time.output_every > 0)
+    for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
+                                        std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
+      if (!ok) log->warn("time.output_every: the {} '{}' cannot write output (supports_output is false)", side, who);
+  // Point interfaces: both sides' measures (int N^T N) should agree, or the Robin terms
+  // weigh the two sides differently (in effect a damping of the wrong size or sign).
+  if (solid_interface_.segments.empty() && fluid_interface.segments.empty() &&
+      solid_interface_.lumped_measure.size() == fluid_interface.lumped_measure.size()) {
+    const double a = solid_interface_.lumped_measure.sum(), b = fluid_interface.lumped_measure.sum();
+    if (std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b)))
+      log->warn("interface measures differ: solid {} vs fluid {} (interface_measure of the two sections)", a, b);
+  }
+  data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
+                       {"max_gap", map_.max_gap()}, {"conforming", map_.conforming()},
+                       {"coincident_nodes", map_.coincident_nodes()}};
+  if (map_.conforming()) {
+    data["interface"]["permutation_error"] = map_.permutation_error();
+    log->info("conforming interface: the {} fluid nodes are the solid's (max gap {:.3g} m), H is a permutation "
+              "(max |H - P| {:.3g})", fluid_interface.nodes(), map_.max_gap(), map_.permutation_error());
+  } else {
+    log->info("non-conforming interface: {} of the {} fluid nodes coincide with one of the {} solid nodes "
+              "(within {:.3g} m), max gap to the solid's interface {:.3g} m: H interpolates",
+              map_.coincident_nodes(), fluid_interface.nodes(), ns, map_.coincidence_tolerance(), map_.max_gap());
+  }
+  consistent_damping_ = implicit && gamma > 0 && settings_.robin_mass == RobinMass::Consistent;
+  if (consistent_damping_ && !solid_.supports_interface_mass()) {
+    consistent_damping_ = false;
+    log->warn("the solid '{}' does not take the interface mass (supports_interface_mass): Algorithm 2's damping "
+              "uses its own int N^T N, and the gamma_N1 terms do not cancel exactly at convergence "
+              "(coupling.work_uncancelled in probes.csv)",
+              solid_.name());
+  }
+  data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
+                      {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
+                      {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
+                      {"acceleration", to_string(settings_.acceleration)},
+                      {"robin_mass", to_string(settings_.robin_mass)}};
+  nlohmann::json measures = nlohmann::json::array();
+  for (const auto& m : settings_.measures)
+    measures.push_back({{"name", m.name()}, {"limit", m.limit}, {"strict", m.strict}});
+  data["coupling"]["measures"] = measures;
+  data["coupling"]["combine"] = settings_.combine_all ? "all" : "any";
+  log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
+            to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
+            settings_.tolerance, ns, fluid_interface.nodes());
+}
+
+void Coupler::write_output(Run& r, const StepInfo& info, const InterfaceFields& fields) {
+  ++r.output_requests;
+  if (solid_.supports_output()) {
+    Timer t(times_.solid);
+    r.files_written["solid"] += solid_.write_output(info).size();
+  }
+  if (fluid_.supports_output()) {
+    Timer t(times_.fluid);
+    r.files_written["fluid"] += fluid_.write_output(info).size();
+  }
+  {
+    Timer t(times_.coupler);
+    r.interface_output->write(info.time, info.step, fields);
+  }
+  if (r.output_requests == 3)
+    for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
+                                        std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
+      if (ok && r.files_written[side] == 0)
+        r.log->warn("time.output_every = {}: the {} '{}' wrote no VTK in {} requests (does its section turn "
+                    "output off? {})",
+                    r.time.output_every, side, who, r.output_requests,
+                    std::string(side) == "solid" ? "solid.output_every" : "fluid.output.vtk_every");
+}
+
+NodalMatrix Coupler::map_mass(Run& r, const FluidLoads& loads) {
+  if (loads.interface_mass.rows() == 0) {
+    if (!r.warned_no_fluid_mass && r.gamma > 0 && settings_.robin_mass == RobinMass::Consistent)
+      r.log->warn("the fluid '{}' does not send its interface mass M_f: the gamma_N1 terms use the solid's "
+                  "polyline int N^T N and cancel at convergence only where it equals H^T M_f H",
+                  fluid_.name());
+    r.warned_no_fluid_mass = true;
+    return NodalMatrix();
+  }
+  try {
+    return map_.mass_to_solid(loads.interface_mass);
+  } catch (const std::invalid_argument& e) {
+    throw Stop{"failed", fmt::format("fluid '{}': {}", fluid_.name(), e.what())};
+  }
+}
+
+void Coupler::start_state(Run& r) {
+  if (r.checkpoints || resume_)
+    for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_checkpoint(), solid_.name()},
+                                        std::tuple{"fluid", fluid_.supports_checkpoint(), fluid_.name()}})
+      if (!ok)
+        throw Stop{"failed", fmt::format("{} needs checkpoints, which the {} '{}' does not support",
+                                         resume_ ? "--resume" : "time.checkpoint_every", side, who)};
+  find_restart(r);
+  if (r.restart)
+    load_restart(r);
+  else
+    initial_state(r);
+  if (r.checkpoints)
+    r.data["checkpoints"] = {{"every", r.time.checkpoint_every}, {"keep", r.time.checkpoint_keep}, {"written", 0},
+                             {"seconds", 0.0}, {"folder", (out_dir_ / "checkpoints").string()}};
+  if (r.restart) r.data["resumed_from_step"] = r.restart->step;
+  r.data["wall_time_earlier_segments"] = r.wall_before;
+}
+
+void Coupler::find_restart(Run& r) {
+  if (resume_) {
+    std::vector<std::string> skipped;
+    r.restart = r.store.newest(&skipped);
+    for (const auto& why : skipped) r.log->warn("skipping checkpoint {}", why);
+    if (!r.restart && !allow_fresh_start_)
+      throw Stop{"failed", fmt::format("--resume: no complete checkpoint in {}{}", (out_dir_ / "checkpoints").string(),
+                                       skipped.empty() ? std::string() : " (" + skipped.front() + ")")};
+    if (!r.restart) r.log->warn("no complete checkpoint yet: starting again from step 0");
+  }
+  // A forked run (fsi run --from): OUT/forked_from.json names the checkpoint it started from;
+  // at that checkpoint the scene may differ (the changes are listed in summary.json), and
+  // its probes.csv and iterations.csv hold only the steps after it.
+  if (std::filesystem::exists(out_dir_ / "forked_from.json")) {
+    try {
+      std::ifstream in(out_dir_ / "forked_from.json");
+      r.fork = nlohmann::json::parse(in);
+    } catch (const std::exception& e) {
+      throw Stop{"failed", fmt::format("{}: does not parse ({})", (out_dir_ / "forked_from.json").string(), e.what())};
+    }
+    r.data["forked_from"] = r.fork;
+  }
+  r.fork_step = r.fork.is_object() ? r.fork.value("step", 0) : 0;
+  r.fork_iterations = r.fork.is_object() ? r.fork.value("iterations", 0L) : 0L;
+  r.at_fork = r.fork.is_object() && r.restart && r.restart->step == r.fork_step;
+}
+
+void Coupler::load_restart(Run& r) {
+  const CheckpointStore::Loaded& restart = *r.restart;
+  const int step = restart.step;
+  const auto diffs = parameter_differences(restart.manifest.value("parameters", nlohmann::json::object()), r.parameters);
+  if (r.at_fork) {
+    r.data["forked_from"]["changed"] = diffs;
+    for (const auto& d : diffs) r.log->info("forked with {}", d);
+  } else if (!diffs.empty()) {
+    std::string list;
+    for (const auto& d : diffs) list += "\n  " + d;
+    throw Stop{"failed", fmt::format("--resume: the scene differs from the one checkpoint {} was written with "
+                                     "({} key(s)):{}",
+                                     restart.dir.string(), diffs.size(), list)};
+  }
+  for (const char* part : {"solid", "fluid", "coupler"})
+    if (!restart.parts.count(part))
+      throw Stop{"failed", fmt::format("checkpoint {} has no '{}' part", restart.dir.string(), part)};
+  r.log->info("resuming from the checkpoint of step {} (t = {}) in {}", step, restart.time, restart.dir.string());
+  {
+    Timer t(times_.solid);
+    solid_.load_checkpoint(step, restart.time, restart.parts.at("solid"));
+  }
+  {
+    Timer t(times_.fluid);
+    fluid_.load_checkpoint(step, restart.time, restart.parts.at("fluid"));
+  }
+  const StateArchive c = StateArchive::parse(restart.parts.at("coupler"), "coupler checkpoint of step " +
+                                                                               std::to_string(step));
+  if (c.integer("step") != step)
+    throw Stop{"failed", fmt::format("checkpoint {}: coupler part is of step {}", restart.dir.string(), c.integer("step"))};
+  read_coupler_state(r, c);
+  if (r.at_fork) convert_forked_predictor(r, c);
+  r.wall_before = restart.manifest.value("wall_seconds", 0.0);
+  r.out.steps = step;
+  r.out.resumed_from = step;
+}
+
+void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
+  State& st = r.state;
+  const Eigen::Index ns = r.ns;
+  const std::string dir = r.restart->dir.string();
+  st.force_n = c.vector("force_n", 2 * ns);
+  st.force_nm1 = c.vector("force_nm1", 2 * ns);
+  st.d_s_prev = c.vector("d_s_prev", 2 * ns);
+  st.d_f_prev = c.vector("d_f_prev", st.d_f_prev.size());
+  if (c.has("v_s_prev")) st.v_s_prev = c.vector("v_s_prev", 2 * ns);
+  if (c.has("work_uncancelled")) st.work_uncancelled = c.real("work_uncancelled");
+  if (c.has("mapped_mass.values")) {
+    const Eigen::VectorXd rows = c.vector("mapped_mass.rows"), cols = c.vector("mapped_mass.cols"),
+                          values = c.vector("mapped_mass.values");
+    if (rows.size() != values.size() || cols.size() != values.size())
+      throw Stop{"failed", fmt::format("checkpoint {}: coupler part has a malformed mapped_mass", dir)};
+    std::vector<Eigen::Triplet<double>> t;
+    for (Eigen::Index k = 0; k < values.size(); ++k) {
+      const auto row = static_cast<Eigen::Index>(rows[k]), col = static_cast<Eigen::Index>(cols[k]);
+      if (row < 0 || row >= ns || col < 0 || col >= ns)
+        throw Stop{"failed", fmt::format("checkpoint {}: coupler mapped_mass entry ({}, {}) outside {} nodes", dir,
+                                         row, col, ns)};
+      t.emplace_back(row, col, values[k]);
+    }
+    st.mapped_mass.resize(ns, ns);
+    st.mapped_mass.setFromTriplets(t.begin(), t.end());
+  } else if (r.implicit && r.gamma > 0) {
+    r.log->warn("checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
+                "solid's own int N^T N", dir, r.restart->step + 1);
+  }
+  st.work_solid = c.real("work_solid");
+  st.work_fluid = c.real("work_fluid");
+  st.work_fluid_on_solid = c.real("work_fluid_on_solid");
+  r.out.iterations = static_cast<long>(c.integer("iterations"));
+  r.accelerator.load(c, "accelerator.");
+}
+
+void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
+  // F_n holds the algorithm's own Robin part: Algorithm 2's force is the load the solid
+  // felt plus gamma_N1 C v_n. Forked into another algorithm or gamma_N1, convert it (the
+  // predictor of the next step), and drop the accelerator's reused secant pairs (they
+  // live in the old force's space).
+  const auto& old = r.restart->manifest.value("parameters", nlohmann::json::object()).value("coupling", nlohmann::json::object());
+  auto number = [](const nlohmann::json& j, const char* key, double fallback) {
+    if (!j.contains(key)) return fallback;
+    const auto& v = j.at(key);
+    return v.is_number() ? v.get<double>() : v.is_string() ? std::stod(v.get<std::string>()) : fallback;
+  };
+  const double gamma = r.gamma;
+  const int old_algorithm = static_cast<int>(number(old, "algorithm", static_cast<double>(settings_.algorithm)));
+  const double old_gamma = number(old, "gamma_n1", gamma);
+  if (old_algorithm == static_cast<int>(settings_.algorithm) && old_gamma == gamma) return;
+  State& st = r.state;
+  const NodalMatrix c_mass = st.mapped_mass.rows() > 0 ? st.mapped_mass : nodal_interface_mass(solid_interface_, {});
+  if (!c.has("v_s_prev"))
+    r.log->warn("checkpoint {} holds no interface velocity (an earlier version): the first step's predictor "
+                "keeps the old algorithm's force", r.restart->dir.string());
+  else {
+    for (Eigen::VectorXd* f : {&st.force_n, &st.force_nm1}) {
+      if (old_algorithm == 2 && old_gamma > 0) *f -= old_gamma * apply_nodal(c_mass, st.v_s_prev);
+      if (r.implicit && gamma > 0) *f += gamma * apply_nodal(c_mass, st.v_s_prev);
+    }
+    r.data["forked_from"]["predictor_converted"] = true;
+  }
+  r.accelerator = InterfaceAccelerator(settings_);
+  r.log->info("forked from algorithm {} (gamma_N1 {}) into algorithm {} (gamma_N1 {}): the force predictor "
+              "converted, the reused secant pairs dropped",
+              old_algorithm, old_gamma, static_cast<int>(settings_.algorithm), gamma);
+}
+
+void Coupler::initial_state(Run& r) {
+  State& st = r.state;
+  const Eigen::VectorXd &d_s = st.d_s_prev, &v_s = st.v_s_prev;  // the scene's initial state
+  FluidLoads loads;
+  {
+    Timer t(times_.fluid);
+    loads = fluid_.initial_loads(map_.to_fluid(d_s), map_.to_fluid(v_s));
+  }
+  Timer t(times_.coupler);
+  st.mapped_mass = map_mass(r, loads);
+  st.force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s,
+                            st.mapped_mass);
+  st.force_nm1 = st.force_n;
+  if (r.time.output_every > 0) {  // the initial state, t = 0
+    write_output(r, StepInfo{0.0, r.time.dt, 0, 0},
+                 InterfaceFields{d_s, v_s, st.force_n, map_.to_solid(loads.traction_force),
+                                 map_.to_solid(loads.velocity_integral), map_.to_fluid(d_s), map_.to_fluid(v_s),
+                                 loads.traction_force, loads.velocity_integral});
+  }
+}
+
+void Coupler::open_tables(Run& r) {
+  std::vector<std::string> iteration_columns{"step",          "time",          "iteration",         "residual",
+                                             "force_norm",    "solid_newton",  "fluid_iterations",  "traction_change",
+                                             "traction_norm", "displacement_change", "displacement_norm",
+                                             "velocity_change", "velocity_norm"};
+  for (const auto& m : settings_.measures) iteration_columns.push_back(m.name());
+  const bool resume_tables = r.restart && !r.at_fork;
+  const auto kept_steps = resume_tables ? static_cast<std::size_t>(r.restart->step - r.fork_step) : 0;
+  r.probes.emplace(resume_tables ? ProbeTable::resume(out_dir_ / "probes.csv", kept_steps)
+                                 : ProbeTable(out_dir_ / "probes.csv"));
+  r.iterations = resume_tables ? CsvWriter::resume(out_dir_ / "iterations.csv",
+                                                   static_cast<std::size_t>(r.out.iterations - r.fork_iterations),
+                                                   iteration_columns)
+                               : CsvWriter(out_dir_ / "iterations.csv", iteration_columns);
+  // Wall time per step (not byte-identical across runs, so apart from probes.csv): cumulative
+  // seconds of the run, its fluid and solid requests, for cost per simulated second.
+  const std::vector<std::string> timing_columns{"step", "time", "wall", "fluid", "solid", "iterations"};
+  const auto timing_path = out_dir_ / "timing.csv";
+  r.timing = resume_tables && std::filesystem::exists(timing_path)
+                 ? CsvWriter::resume(timing_path, kept_steps, timing_columns)
+                 : CsvWriter(timing_path, timing_columns);
+  r.progress.emplace("coupler", r.time.steps, r.out.steps);
+  r.segment_start = now();
+}
+
+void Coupler::save_checkpoint(Run& r, int n, double t_np1) {
+  Timer t(times_.checkpoint);
+  const State& st = r.state;
+  std::map<std::string, std::string> parts;
+  parts["solid"] = solid_.save_checkpoint(n, t_np1);
+  parts["fluid"] = fluid_.save_checkpoint(n, t_np1);
+  StateArchive c;
+  c.put("step", static_cast<std::int64_t>(n));
+  c.put("force_n", st.force_n);
+  c.put("force_nm1", st.force_nm1);
+  c.put("d_s_prev", st.d_s_prev);
+  c.put("d_f_prev", st.d_f_prev);
+  c.put("work_solid", st.work_solid);
+  c.put("work_fluid", st.work_fluid);
+  c.put("work_fluid_on_solid", st.work_fluid_on_solid);
+  c.put("work_uncancelled", st.work_uncancelled);
+  c.put("v_s_prev", st.v_s_prev);
+  if (st.mapped_mass.rows() > 0) {
+    std::vector<double> rows, cols, values;
+    for (int col = 0; col < st.mapped_mass.outerSize(); ++col)
+      for (NodalMatrix::InnerIterator it(st.mapped_mass, col); it; ++it)
+        rows.push_back(double(it.row())), cols.push_back(double(it.col())), values.push_back(it.value());
+    c.put("mapped_mass.rows", rows);
+    c.put("mapped_mass.cols", cols);
+    c.put("mapped_mass.values", values);
+  }
+  c.put("iterations", static_cast<std::int64_t>(r.out.iterations));
+  r.accelerator.save(c, "accelerator.");
+  parts["coupler"] = c.serialize();
+  nlohmann::json manifest = {{"scene", r.data.value("scene", std::string())},
+                             {"scene_file", scene_.origin()},
+                             {"overrides", scene_.overrides()},
+                             {"parameters", r.parameters},
+                             {"iterations", r.out.iterations},
+                             {"wall_seconds", r.wall_before + (now() - r.segment_start)}};
+  const auto written = r.store.write(n, t_np1, manifest, parts);
+  auto& info = r.data["checkpoints"];
+  info["written"] = info.value("written", 0) + 1;
+  info["last_step"] = n;
+  info["last_bytes"] = written.bytes;
+  info["parts_bytes"] = {{"solid", parts["solid"].size()}, {"fluid", parts["fluid"].size()},
+                         {"coupler", parts["coupler"].size()}};
 }
 
 }  // namespace fsi::coupling

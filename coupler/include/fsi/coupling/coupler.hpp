@@ -24,6 +24,8 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <string>
 
 #include "fsi/common/config.hpp"
 #include "fsi/common/run_report.hpp"
@@ -31,7 +33,14 @@
 #include "fsi/coupling/interface_map.hpp"
 #include "fsi/coupling/settings.hpp"
 
+namespace fsi {
+struct TimeSettings;  // fsi/common/standalone.hpp
+class StateArchive;   // fsi/common/state.hpp
+}
+
 namespace fsi::coupling {
+
+struct InterfaceFields;  // fsi/coupling/interface_output.hpp
 
 struct RunOutcome {
   std::string status = "running";  // completed / diverged / failed / interrupted
@@ -83,6 +92,27 @@ class Coupler {
   // The operator of the fluid's penalty term seen from the solid: mapped_mass, or without one
   // (a fluid that does not send M_f) the solid's polyline mass in the current configuration.
   NodalMatrix physical_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const;
+  // The parts of run(), in the order it calls them (types defined in coupler.cpp).
+  struct Run;      // one run: its settings, outputs, tables, checkpoints, accelerator and State
+  struct State;    // what carries from one accepted step to the next (and into a checkpoint)
+  // 1. The scene's time and coupling sections; both solvers configured, the interface map.
+  TimeSettings configure(InterfaceMeshData& fluid_interface);
+  // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
+  void describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface);
+  // 2. The state the first step starts from: a checkpoint (resume, fork) or the initial one.
+  void start_state(Run& r);
+  void find_restart(Run& r);                           // --resume's checkpoint, forked_from.json
+  void load_restart(Run& r);                           // both solvers' and the coupler's parts
+  void read_coupler_state(Run& r, const StateArchive& c);
+  void convert_forked_predictor(Run& r, const StateArchive& c);  // forked into another algorithm / gamma_N1
+  void initial_state(Run& r);                          // F_0 = -F*(initial fluid state)
+  // probes.csv, iterations.csv and timing.csv: new, or continued after the checkpoint.
+  void open_tables(Run& r);
+  void save_checkpoint(Run& r, int n, double t_np1);
+  // H^T M_f H of a fluid solve (empty when the fluid does not send M_f).
+  NodalMatrix map_mass(Run& r, const FluidLoads& loads);
+  void write_output(Run& r, const StepInfo& info, const InterfaceFields& fields);
+
   bool consistent_damping_ = false;  // Algorithm 2 and the solid takes H^T M_f H
   SolidModel& solid_;
   FluidModel& fluid_;
