@@ -77,8 +77,8 @@ NodalMatrix Coupler::physical_mass(const Eigen::VectorXd& solid_displacement, co
 }
 
 // ---------------------------------------------------------------------------------------
-// The run's parts. run() reads as: configure, describe, start state, open tables, then the
-// time loop.
+// The run's parts. run() reads as: configure, describe, start state, open tables, then per
+// step: begin, coupling iterations until converged, accept.
 
 // What carries from one accepted step to the next, and what a checkpoint saves of the
 // coupler (with the accelerator's reused secant pairs and the iteration count).
@@ -93,6 +93,40 @@ struct Coupler::State {
   double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0, work_uncancelled = 0;
   // M_G = H^T M_f H of the fluid's last solve (empty when the fluid does not send M_f).
   NodalMatrix mapped_mass;
+};
+
+// One coupling iteration's solves; the step accepts its last one.
+struct Coupler::Iterate {
+  Eigen::VectorXd force_applied;  // F^(k), the solid's load
+  SolidStepResult s;
+  FluidLoads loads;
+  Eigen::VectorXd d_f;       // the fluid's interface displacement H d_s
+  Eigen::VectorXd traction;  // the physical traction H^T R (without the fluid's penalty part)
+  NodalMatrix damping;       // Algorithm 2's damping operator of the solid solve (else empty)
+  NodalMatrix mass;          // H^T M_f H of the fluid solve
+};
+
+// The step n -> n+1 being iterated.
+struct Coupler::Step {
+  int n = 0;
+  double t_np1 = 0;
+  int k = 1;              // the coupling iteration; k_max + 1 after k_max unconverged ones
+  Eigen::VectorXd force;  // F^(k)
+  double first_residual = 0, residual = 0, first_change = 0;
+  bool converged = false;
+  std::vector<double> first_r, values;  // the measures' k = 1 quantities and their values
+  Eigen::VectorXd d_iter_prev, v_iter_prev;  // the last iteration's solid interface state
+  Iterate last;
+};
+
+// What one coupling iteration gives.
+struct Coupler::Update {
+  Iterate iterate;
+  Eigen::VectorXd relaxed;  // F^(k+1)
+  double norm = 0, change = 0;
+  // The interface quantities' changes and sizes: force, traction, displacement, velocity
+  // (iterations.csv, convergence measures).
+  double r_quantity[4] = {0, 0, 0, 0}, q_quantity[4] = {0, 0, 0, 0};
 };
 
 // One run: what it was configured with, its outputs and tables, checkpoints and State.
@@ -172,227 +206,18 @@ RunOutcome Coupler::run(RunReport& report) {
     start_state(r);
     // 3. Time loop.
     open_tables(r);
-    State& st = r.state;
-    const double gamma = r.gamma;
-    const bool implicit = r.implicit;
     for (int n = out.steps + 1; n <= time.steps; ++n) {
-      const double t_np1 = n * time.dt;
-      Eigen::VectorXd force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * st.force_n - st.force_nm1)
-                                                                               : st.force_n;
-      double first_residual = 0, residual = 0, first_change = 0;
-      const std::size_t n_measures = settings_.measures.size();
-      bool converged = n_measures == 0;
-      std::vector<double> first_r(n_measures, 0.0), values(n_measures, 0.0);
-      int k = 1;
-      r.accelerator.begin_step();
-      SolidStepResult s_last;
-      FluidLoads loads_last;
-      Eigen::VectorXd force_applied, d_f_last, traction_last;
-      NodalMatrix damping_last, mass_last;
-      Eigen::VectorXd d_iter_prev = st.d_s_prev, v_iter_prev = st.v_s_prev;
-      for (; k <= settings_.max_iterations; ++k) {
-        if (interrupt_flag())
-          throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
-        const StepInfo info{t_np1, time.dt, n, k};
-        // Algorithm 2: the damping operator of this solve: H^T M_f H of the fluid's last solve
-        // (consistent), or the solid's own int N^T N.
-        const NodalMatrix damping = solid_damping_mass(st.mapped_mass);
-        if (consistent_damping_ && st.mapped_mass.rows() > 0) {
-          Timer t(times_.solid);
-          solid_.set_interface_mass(damping);
-        }
-        SolidStepResult s;
-        {
-          Timer t(times_.solid);
-          s = solid_.solve_step(info, force);
-        }
-        if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
-          throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
-        Eigen::VectorXd d_f, v_f;
-        {
-          Timer t(times_.coupler);
-          d_f = map_.to_fluid(s.interface_displacement);
-          v_f = map_.to_fluid(s.interface_velocity);
-        }
-        FluidLoads loads;
-        {
-          Timer t(times_.fluid);
-          loads = fluid_.solve_step(info, d_f, v_f);
-        }
-        Eigen::VectorXd relaxed, traction, traction_change;
-        NodalMatrix mass_k;
-        {
-          Timer t(times_.coupler);
-          mass_k = map_mass(r, loads);
-          const Eigen::VectorXd fs = map_.to_solid(loads.traction_force), fv = map_.to_solid(loads.velocity_integral);
-          const Eigen::VectorXd f_star = robin_force(fs, fv, s.interface_velocity, s.interface_displacement, mass_k);
-          // The physical traction H^T R = f_sigma - gamma (f_v - M_f v_s) (the fluid's reaction,
-          // without its penalty part), and its mismatch with what the solid felt: its load
-          // F^(k) minus its own Robin damping gamma C v_s.
-          traction = gamma > 0 ? Eigen::VectorXd(fs - gamma * (fv - apply_nodal(physical_mass(s.interface_displacement, mass_k),
-                                                                                 s.interface_velocity)))
-                               : fs;
-          traction_change = traction + force;
-          if (damping.rows() > 0) traction_change -= gamma * apply_nodal(damping, s.interface_velocity);
-          // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
-          // (acceleration.hpp for Aitken and IQN-ILS).
-          relaxed = r.accelerator.update(force, -f_star - force);
-          st.mapped_mass = mass_k;  // the next solid solve's damping (Algorithm 2)
-        }
-        if (!all_finite(relaxed))
-          throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
-        const double norm = relaxed.norm();
-        const double change = (relaxed - force).norm();
-        residual = change / std::max(norm, settings_.residual_floor);
-        // The interface quantities' changes and sizes (iterations.csv, convergence measures).
-        const double r_quantity[4] = {change, traction_change.norm(), (s.interface_displacement - d_iter_prev).norm(),
-                                      (s.interface_velocity - v_iter_prev).norm()};
-        const double q_quantity[4] = {norm, traction.norm(), s.interface_displacement.norm(),
-                                      s.interface_velocity.norm()};
-        d_iter_prev = s.interface_displacement;
-        v_iter_prev = s.interface_velocity;
-        bool all_met = true, any_met = false;
-        for (std::size_t i = 0; i < n_measures; ++i) {
-          const auto& m = settings_.measures[i];
-          const int q = static_cast<int>(m.quantity);
-          const double r = r_quantity[q];
-          if (k == 1) first_r[i] = r;
-          values[i] = m.type == MeasureType::Absolute   ? r
-                      : m.type == MeasureType::Relative ? r / std::max(q_quantity[q], settings_.residual_floor)
-                      : k == 1                          ? 1.0
-                                                        : r / std::max(first_r[i], settings_.residual_floor);
-          const bool met = values[i] < m.limit && !(m.type == MeasureType::ResidualRelative && k == 1 && r > 0);
-          all_met = all_met && met;
-          any_met = any_met || met;
-        }
-        std::vector<double> row_values{double(n),        t_np1,           double(k),        residual,
-                                       norm,             double(s.newton_iterations), double(loads.nonlinear_iterations),
-                                       r_quantity[1],    q_quantity[1],   r_quantity[2],    q_quantity[2],
-                                       r_quantity[3],    q_quantity[3]};
-        row_values.insert(row_values.end(), values.begin(), values.end());
-        r.iterations.row(row_values);
-        force_applied = force;
-        s_last = s;
-        loads_last = loads;
-        d_f_last = d_f;
-        traction_last = traction;
-        damping_last = damping;
-        mass_last = mass_k;
-        force = relaxed;
-        ++out.iterations;
-        if (norm > settings_.force_limit)
-          throw Stop{"diverged", fmt::format("interface force norm {:.3e} exceeds force_limit {:.3e} at step {} "
-                                             "iteration {} (loosely coupled instability?)",
-                                             norm, settings_.force_limit, n, k)};
-        if (k == 1) first_residual = residual, first_change = change;
-        if (n_measures > 0) {
-          if (settings_.combine_all ? all_met : any_met) {
-            converged = true;
-            break;
-          }
-          // Geometric growth keeps the relative residual constant: watch the absolute change.
-          if (k > 1 && (residual > settings_.divergence_factor * std::max(first_residual, settings_.residual_floor) ||
-                        change > settings_.divergence_factor * std::max(first_change, settings_.residual_floor)))
-            throw Stop{"diverged", fmt::format("coupling residual grew: |F^(k+1) - F^(k)| from {:.3e} to {:.3e} "
-                                               "(relative {:.3e} to {:.3e}) at step {} iteration {} "
-                                               "(relaxation {} above the stability limit?)",
-                                               first_change, change, first_residual, residual, n, k,
-                                               settings_.relaxation)};
+      Step step = begin_step(r, n);
+      for (; step.k <= settings_.max_iterations; ++step.k) {
+        const Update u = coupling_iteration(r, step);
+        const bool met = measures_met(step, u);
+        if (finish_iteration(r, step, u, met)) {
+          step.converged = true;
+          break;
         }
       }
-      if (!converged)
-        for (std::size_t i = 0; i < n_measures; ++i) {
-          const auto& m = settings_.measures[i];
-          if (m.strict && !(values[i] < m.limit))
-            throw Stop{"diverged", fmt::format("coupling measure {} (strict) not met in {} iterations at step {}: "
-                                               "{:.3e} >= {:.1e}",
-                                               m.name(), settings_.max_iterations, n, values[i], m.limit)};
-        }
-      const int used = std::min(k, settings_.max_iterations);
-      if (!converged && settings_.stop_if_not_converged) {
-        std::string missed;
-        for (std::size_t i = 0; i < n_measures; ++i)
-          missed += fmt::format("{}{} {:.3e} (limit {:.1e})", missed.empty() ? "" : ", ", settings_.measures[i].name(),
-                                values[i], settings_.measures[i].limit);
-        throw Stop{"diverged", fmt::format("coupling tolerance not reached in {} iterations at step {}: {} (force residual "
-                                           "{:.3e}, first {:.3e})",
-                                           settings_.max_iterations, n, missed, residual, first_residual)};
-      }
-      // Accept the step on both sides; record probes.
-      const StepInfo accepted{t_np1, time.dt, n, used};
-      std::map<std::string, double> row;
-      {
-        Timer t(times_.solid);
-        for (const auto& [name, v] : solid_.accept_step(accepted)) row["solid." + name] = v;
-      }
-      {
-        Timer t(times_.fluid);
-        for (const auto& [name, v] : fluid_.accept_step(accepted)) row["fluid." + name] = v;
-      }
-      {
-        Timer t(times_.coupler);
-        st.work_solid += force_applied.dot(s_last.interface_displacement - st.d_s_prev);
-        st.work_fluid -= loads_last.traction_force.dot(d_f_last - st.d_f_prev);
-        // The same work evaluated on the solid's nodes through the transpose mapping:
-        // identical up to round-off (the mapping neither creates nor destroys energy).
-        st.work_fluid_on_solid -= map_.to_solid(loads_last.traction_force).dot(s_last.interface_displacement - st.d_s_prev);
-        // The interface power balance of the step (average over dt): the coupling load in the
-        // solid's equation (its force and its own Robin damping), the physical traction of the
-        // fluid, and the part of the gamma_N1 terms that would remain at exact convergence,
-        // gamma (H^T M_f H - C) v_s with both operators in the accepted configuration (zero
-        // when the solid's operator is the fluid's, robin_mass: consistent).
-        const Eigen::VectorXd dd = s_last.interface_displacement - st.d_s_prev;
-        const Eigen::VectorXd& v = s_last.interface_velocity;
-        Eigen::VectorXd load = force_applied;
-        if (damping_last.rows() > 0) load -= gamma * apply_nodal(damping_last, v);
-        double uncancelled = 0;
-        if (gamma > 0) {
-          const NodalMatrix m_phys = physical_mass(s_last.interface_displacement, mass_last);
-          const NodalMatrix c_cfg = implicit ? solid_damping_mass(mass_last)
-                                             : algorithm1_mass(s_last.interface_displacement, mass_last);
-          uncancelled = gamma * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
-        }
-        st.work_uncancelled += uncancelled;
-        row["coupling.power_solid"] = load.dot(dd) / time.dt;
-        row["coupling.power_fluid"] = -traction_last.dot(dd) / time.dt;
-        row["coupling.power_uncancelled"] = uncancelled / time.dt;
-        row["coupling.work_uncancelled"] = st.work_uncancelled;
-        Eigen::Vector2d total = Eigen::Vector2d::Zero();
-        for (Eigen::Index i = 0; i < r.ns; ++i) total -= traction_last.segment<2>(2 * i);
-        row["coupling.solid_force_x"] = total(0);
-        row["coupling.solid_force_y"] = total(1);
-        st.d_s_prev = s_last.interface_displacement;
-        st.v_s_prev = s_last.interface_velocity;
-        st.d_f_prev = d_f_last;
-      }
-      row["coupling.iterations"] = used;
-      row["coupling.residual"] = residual;
-      row["coupling.work_solid"] = st.work_solid;
-      row["coupling.work_fluid"] = st.work_fluid;
-      row["coupling.work_mapping_error"] = std::abs(st.work_fluid - st.work_fluid_on_solid);
-      for (const auto& [name, v] : row)
-        if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
-      r.probes->add(t_np1, row);
-      // before the checkpoint of this step, so a checkpoint never has fewer timing rows than steps
-      r.timing.row(std::vector<double>{double(n), t_np1, r.wall_before + (now() - r.segment_start), times_.fluid, times_.solid,
-                                     double(used)});
-      if (time.output_every > 0 && n % time.output_every == 0)
-        write_output(r, accepted, InterfaceFields{s_last.interface_displacement, s_last.interface_velocity, force_applied,
-                                               map_.to_solid(loads_last.traction_force),
-                                               map_.to_solid(loads_last.velocity_integral), d_f_last,
-                                               map_.to_fluid(s_last.interface_velocity), loads_last.traction_force,
-                                               loads_last.velocity_integral});
-      r.accelerator.end_step();
-      st.force_nm1 = st.force_n;
-      st.force_n = force;
-      out.steps = n;
-      if (r.checkpoints && n % time.checkpoint_every == 0 && n < time.steps) {
-        save_checkpoint(r, n, t_np1);
-        r.data["checkpoints"]["seconds"] = times_.checkpoint;
-      }
-      times_.total = now() - r.start;
-      if (on_step) on_step(out);
-      r.progress->update(n, t_np1, fmt::format("iterations {} residual {:.2e}", used, residual));
+      check_unconverged(step);
+      accept_step(r, step);
     }
     out.status = "completed";
   } catch (const Stop& stop) {
@@ -742,6 +567,249 @@ void Coupler::open_tables(Run& r) {
                  : CsvWriter(timing_path, timing_columns);
   r.progress.emplace("coupler", r.time.steps, r.out.steps);
   r.segment_start = now();
+}
+
+Coupler::Step Coupler::begin_step(Run& r, int n) {
+  Step step;
+  step.n = n;
+  step.t_np1 = n * r.time.dt;
+  const State& st = r.state;
+  step.force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * st.force_n - st.force_nm1)
+                                                                 : st.force_n;
+  const std::size_t n_measures = settings_.measures.size();
+  step.converged = n_measures == 0;
+  step.first_r.assign(n_measures, 0.0);
+  step.values.assign(n_measures, 0.0);
+  r.accelerator.begin_step();
+  step.d_iter_prev = st.d_s_prev;
+  step.v_iter_prev = st.v_s_prev;
+  return step;
+}
+
+Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
+  const int n = step.n, k = step.k;
+  const double gamma = r.gamma;
+  if (interrupt_flag())
+    throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
+  const StepInfo info{step.t_np1, r.time.dt, n, k};
+  Update u;
+  Iterate& it = u.iterate;
+  // Algorithm 2: the damping operator of this solve: H^T M_f H of the fluid's last solve
+  // (consistent), or the solid's own int N^T N.
+  it.damping = solid_damping_mass(r.state.mapped_mass);
+  if (consistent_damping_ && r.state.mapped_mass.rows() > 0) {
+    Timer t(times_.solid);
+    solid_.set_interface_mass(it.damping);
+  }
+  const SolidStepResult& s = it.s;
+  {
+    Timer t(times_.solid);
+    it.s = solid_.solve_step(info, step.force);
+  }
+  if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
+    throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
+  Eigen::VectorXd v_f;
+  {
+    Timer t(times_.coupler);
+    it.d_f = map_.to_fluid(s.interface_displacement);
+    v_f = map_.to_fluid(s.interface_velocity);
+  }
+  {
+    Timer t(times_.fluid);
+    it.loads = fluid_.solve_step(info, it.d_f, v_f);
+  }
+  Eigen::VectorXd traction_change;
+  {
+    Timer t(times_.coupler);
+    it.mass = map_mass(r, it.loads);
+    const Eigen::VectorXd fs = map_.to_solid(it.loads.traction_force), fv = map_.to_solid(it.loads.velocity_integral);
+    const Eigen::VectorXd f_star = robin_force(fs, fv, s.interface_velocity, s.interface_displacement, it.mass);
+    // The physical traction H^T R = f_sigma - gamma (f_v - M_f v_s) (the fluid's reaction,
+    // without its penalty part), and its mismatch with what the solid felt: its load
+    // F^(k) minus its own Robin damping gamma C v_s.
+    it.traction = gamma > 0 ? Eigen::VectorXd(fs - gamma * (fv - apply_nodal(physical_mass(s.interface_displacement, it.mass),
+                                                                              s.interface_velocity)))
+                            : fs;
+    traction_change = it.traction + step.force;
+    if (it.damping.rows() > 0) traction_change -= gamma * apply_nodal(it.damping, s.interface_velocity);
+    // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
+    // (acceleration.hpp for Aitken and IQN-ILS).
+    u.relaxed = r.accelerator.update(step.force, -f_star - step.force);
+    r.state.mapped_mass = it.mass;  // the next solid solve's damping (Algorithm 2)
+  }
+  if (!all_finite(u.relaxed))
+    throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
+  u.norm = u.relaxed.norm();
+  u.change = (u.relaxed - step.force).norm();
+  step.residual = u.change / std::max(u.norm, settings_.residual_floor);
+  const double r_quantity[4] = {u.change, traction_change.norm(), (s.interface_displacement - step.d_iter_prev).norm(),
+                                (s.interface_velocity - step.v_iter_prev).norm()};
+  const double q_quantity[4] = {u.norm, it.traction.norm(), s.interface_displacement.norm(),
+                                s.interface_velocity.norm()};
+  std::copy(r_quantity, r_quantity + 4, u.r_quantity);
+  std::copy(q_quantity, q_quantity + 4, u.q_quantity);
+  step.d_iter_prev = s.interface_displacement;
+  step.v_iter_prev = s.interface_velocity;
+  return u;
+}
+
+bool Coupler::measures_met(Step& step, const Update& u) const {
+  bool all_met = true, any_met = false;
+  for (std::size_t i = 0; i < settings_.measures.size(); ++i) {
+    const auto& m = settings_.measures[i];
+    const int q = static_cast<int>(m.quantity);
+    const double r = u.r_quantity[q];
+    if (step.k == 1) step.first_r[i] = r;
+    step.values[i] = m.type == MeasureType::Absolute   ? r
+                     : m.type == MeasureType::Relative ? r / std::max(u.q_quantity[q], settings_.residual_floor)
+                     : step.k == 1                     ? 1.0
+                                                       : r / std::max(step.first_r[i], settings_.residual_floor);
+    const bool met = step.values[i] < m.limit && !(m.type == MeasureType::ResidualRelative && step.k == 1 && r > 0);
+    all_met = all_met && met;
+    any_met = any_met || met;
+  }
+  return settings_.combine_all ? all_met : any_met;
+}
+
+bool Coupler::finish_iteration(Run& r, Step& step, const Update& u, bool met) {
+  const int n = step.n, k = step.k;
+  std::vector<double> row_values{double(n),          step.t_np1,         double(k),          step.residual,
+                                 u.norm,             double(u.iterate.s.newton_iterations),
+                                 double(u.iterate.loads.nonlinear_iterations),
+                                 u.r_quantity[1],    u.q_quantity[1],    u.r_quantity[2],    u.q_quantity[2],
+                                 u.r_quantity[3],    u.q_quantity[3]};
+  row_values.insert(row_values.end(), step.values.begin(), step.values.end());
+  r.iterations.row(row_values);
+  step.last = u.iterate;
+  step.last.force_applied = step.force;
+  step.force = u.relaxed;
+  ++r.out.iterations;
+  if (u.norm > settings_.force_limit)
+    throw Stop{"diverged", fmt::format("interface force norm {:.3e} exceeds force_limit {:.3e} at step {} "
+                                       "iteration {} (loosely coupled instability?)",
+                                       u.norm, settings_.force_limit, n, k)};
+  if (k == 1) step.first_residual = step.residual, step.first_change = u.change;
+  if (settings_.measures.empty()) return false;
+  if (met) return true;
+  // Geometric growth keeps the relative residual constant: watch the absolute change.
+  if (k > 1 && (step.residual > settings_.divergence_factor * std::max(step.first_residual, settings_.residual_floor) ||
+                u.change > settings_.divergence_factor * std::max(step.first_change, settings_.residual_floor)))
+    throw Stop{"diverged", fmt::format("coupling residual grew: |F^(k+1) - F^(k)| from {:.3e} to {:.3e} "
+                                       "(relative {:.3e} to {:.3e}) at step {} iteration {} "
+                                       "(relaxation {} above the stability limit?)",
+                                       step.first_change, u.change, step.first_residual, step.residual, n, k,
+                                       settings_.relaxation)};
+  return false;
+}
+
+void Coupler::check_unconverged(const Step& step) const {
+  if (step.converged) return;
+  const std::size_t n_measures = settings_.measures.size();
+  for (std::size_t i = 0; i < n_measures; ++i) {
+    const auto& m = settings_.measures[i];
+    if (m.strict && !(step.values[i] < m.limit))
+      throw Stop{"diverged", fmt::format("coupling measure {} (strict) not met in {} iterations at step {}: "
+                                         "{:.3e} >= {:.1e}",
+                                         m.name(), settings_.max_iterations, step.n, step.values[i], m.limit)};
+  }
+  if (!settings_.stop_if_not_converged) return;
+  std::string missed;
+  for (std::size_t i = 0; i < n_measures; ++i)
+    missed += fmt::format("{}{} {:.3e} (limit {:.1e})", missed.empty() ? "" : ", ", settings_.measures[i].name(),
+                          step.values[i], settings_.measures[i].limit);
+  throw Stop{"diverged", fmt::format("coupling tolerance not reached in {} iterations at step {}: {} (force residual "
+                                     "{:.3e}, first {:.3e})",
+                                     settings_.max_iterations, step.n, missed, step.residual, step.first_residual)};
+}
+
+void Coupler::accept_step(Run& r, Step& step) {
+  const int n = step.n;
+  const double t_np1 = step.t_np1;
+  const int used = std::min(step.k, settings_.max_iterations);
+  const Iterate& last = step.last;
+  // Accept the step on both sides; record probes.
+  const StepInfo accepted{t_np1, r.time.dt, n, used};
+  std::map<std::string, double> row;
+  {
+    Timer t(times_.solid);
+    for (const auto& [name, v] : solid_.accept_step(accepted)) row["solid." + name] = v;
+  }
+  {
+    Timer t(times_.fluid);
+    for (const auto& [name, v] : fluid_.accept_step(accepted)) row["fluid." + name] = v;
+  }
+  {
+    Timer t(times_.coupler);
+    interface_balance(r, last, row);
+  }
+  const State& st = r.state;
+  row["coupling.iterations"] = used;
+  row["coupling.residual"] = step.residual;
+  row["coupling.work_solid"] = st.work_solid;
+  row["coupling.work_fluid"] = st.work_fluid;
+  row["coupling.work_mapping_error"] = std::abs(st.work_fluid - st.work_fluid_on_solid);
+  for (const auto& [name, v] : row)
+    if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
+  r.probes->add(t_np1, row);
+  // before the checkpoint of this step, so a checkpoint never has fewer timing rows than steps
+  r.timing.row(std::vector<double>{double(n), t_np1, r.wall_before + (now() - r.segment_start), times_.fluid,
+                                   times_.solid, double(used)});
+  if (r.time.output_every > 0 && n % r.time.output_every == 0)
+    write_output(r, accepted, InterfaceFields{last.s.interface_displacement, last.s.interface_velocity,
+                                              last.force_applied, map_.to_solid(last.loads.traction_force),
+                                              map_.to_solid(last.loads.velocity_integral), last.d_f,
+                                              map_.to_fluid(last.s.interface_velocity), last.loads.traction_force,
+                                              last.loads.velocity_integral});
+  r.accelerator.end_step();
+  r.state.force_nm1 = r.state.force_n;
+  r.state.force_n = step.force;
+  r.out.steps = n;
+  if (r.checkpoints && n % r.time.checkpoint_every == 0 && n < r.time.steps) {
+    save_checkpoint(r, n, t_np1);
+    r.data["checkpoints"]["seconds"] = times_.checkpoint;
+  }
+  times_.total = now() - r.start;
+  if (on_step) on_step(r.out);
+  r.progress->update(n, t_np1, fmt::format("iterations {} residual {:.2e}", used, step.residual));
+}
+
+void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::string, double>& row) {
+  State& st = r.state;
+  const double gamma = r.gamma;
+  const SolidStepResult& s = last.s;
+  st.work_solid += last.force_applied.dot(s.interface_displacement - st.d_s_prev);
+  st.work_fluid -= last.loads.traction_force.dot(last.d_f - st.d_f_prev);
+  // The same work evaluated on the solid's nodes through the transpose mapping:
+  // identical up to round-off (the mapping neither creates nor destroys energy).
+  st.work_fluid_on_solid -= map_.to_solid(last.loads.traction_force).dot(s.interface_displacement - st.d_s_prev);
+  // The interface power balance of the step (average over dt): the coupling load in the
+  // solid's equation (its force and its own Robin damping), the physical traction of the
+  // fluid, and the part of the gamma_N1 terms that would remain at exact convergence,
+  // gamma (H^T M_f H - C) v_s with both operators in the accepted configuration (zero
+  // when the solid's operator is the fluid's, robin_mass: consistent).
+  const Eigen::VectorXd dd = s.interface_displacement - st.d_s_prev;
+  const Eigen::VectorXd& v = s.interface_velocity;
+  Eigen::VectorXd load = last.force_applied;
+  if (last.damping.rows() > 0) load -= gamma * apply_nodal(last.damping, v);
+  double uncancelled = 0;
+  if (gamma > 0) {
+    const NodalMatrix m_phys = physical_mass(s.interface_displacement, last.mass);
+    const NodalMatrix c_cfg = r.implicit ? solid_damping_mass(last.mass)
+                                         : algorithm1_mass(s.interface_displacement, last.mass);
+    uncancelled = gamma * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
+  }
+  st.work_uncancelled += uncancelled;
+  row["coupling.power_solid"] = load.dot(dd) / r.time.dt;
+  row["coupling.power_fluid"] = -last.traction.dot(dd) / r.time.dt;
+  row["coupling.power_uncancelled"] = uncancelled / r.time.dt;
+  row["coupling.work_uncancelled"] = st.work_uncancelled;
+  Eigen::Vector2d total = Eigen::Vector2d::Zero();
+  for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<2>(2 * i);
+  row["coupling.solid_force_x"] = total(0);
+  row["coupling.solid_force_y"] = total(1);
+  st.d_s_prev = s.interface_displacement;
+  st.v_s_prev = s.interface_velocity;
+  st.d_f_prev = last.d_f;
 }
 
 void Coupler::save_checkpoint(Run& r, int n, double t_np1) {

@@ -95,6 +95,9 @@ class Coupler {
   // The parts of run(), in the order it calls them (types defined in coupler.cpp).
   struct Run;      // one run: its settings, outputs, tables, checkpoints, accelerator and State
   struct State;    // what carries from one accepted step to the next (and into a checkpoint)
+  struct Iterate;  // one coupling iteration's solves; a step accepts its last one
+  struct Step;     // the step being iterated: F^(k), the residuals, the measures
+  struct Update;   // what one coupling iteration gives: F^(k+1) and the residual quantities
   // 1. The scene's time and coupling sections; both solvers configured, the interface map.
   TimeSettings configure(InterfaceMeshData& fluid_interface);
   // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
@@ -108,6 +111,15 @@ class Coupler {
   void initial_state(Run& r);                          // F_0 = -F*(initial fluid state)
   // probes.csv, iterations.csv and timing.csv: new, or continued after the checkpoint.
   void open_tables(Run& r);
+  // 3. One step: its iterations, then accept.
+  Step begin_step(Run& r, int n);
+  Update coupling_iteration(Run& r, Step& step);       // solid, fluid, F*, residual, F^(k+1)
+  bool measures_met(Step& step, const Update& u) const;  // the convergence measures
+  // The iteration's row in iterations.csv, F^(k+1); throws on divergence; true when converged.
+  bool finish_iteration(Run& r, Step& step, const Update& u, bool met);
+  void check_unconverged(const Step& step) const;      // strict measures, stop_if_not_converged
+  void accept_step(Run& r, Step& step);                // accept calls, probes, output, checkpoint
+  void interface_balance(Run& r, const Iterate& last, std::map<std::string, double>& row);
   void save_checkpoint(Run& r, int n, double t_np1);
   // H^T M_f H of a fluid solve (empty when the fluid does not send M_f).
   NodalMatrix map_mass(Run& r, const FluidLoads& loads);
