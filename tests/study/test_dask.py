@@ -67,11 +67,20 @@ def stop(p, sig=signal.SIGTERM):
             p.wait(timeout=10)
 
 
-def workers_joined(addr, n, timeout=30):
+def workers_joined(addr, n, timeout=120):
+    """Connects (the scheduler may still be starting on a loaded machine: retried until the
+    deadline) and waits for n workers."""
     from distributed import Client
-    with Client(addr, timeout=timeout) as c:
-        c.wait_for_workers(n, timeout=timeout)
-        return len(c.scheduler_info()["workers"])
+    deadline = time.time() + timeout
+    while True:
+        try:
+            with Client(addr, timeout=min(30, max(1.0, deadline - time.time()))) as c:
+                c.wait_for_workers(n, timeout=max(1.0, deadline - time.time()))
+                return len(c.scheduler_info()["workers"])
+        except (OSError, TimeoutError):
+            if time.time() >= deadline:
+                raise
+            time.sleep(1)
 
 
 def metric_table(d):
