@@ -185,10 +185,7 @@ def cmd_table(a):
         w = r["wall_per_simulated_second"]
         lines.append(head + f" {cell('ux', ('mean', 'amplitude'))} | {cell('uy', ('mean', 'amplitude', 'frequency'))} | "
                      f"{cell('drag', ('mean', 'amplitude'))} | {cell('lift', ('mean', 'amplitude', 'frequency'))} | "
-                     f"{r['iterations_per_step']:.2f} | {w:.0f} |" if w else
-                     head + f" {cell('ux', ('mean', 'amplitude'))} | {cell('uy', ('mean', 'amplitude', 'frequency'))} | "
-                     f"{cell('drag', ('mean', 'amplitude'))} | {cell('lift', ('mean', 'amplitude', 'frequency'))} | "
-                     f"{r['iterations_per_step']:.2f} | - |")
+                     f"{r['iterations_per_step']:.2f} | {f'{w:.0f}' if w else '-'} |")
     done = [lv for lv in (1, 2, 3) if "stats" in rows[lv]]
     if len(done) >= 2:
         f, c = done[-1], done[-2]

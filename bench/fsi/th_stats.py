@@ -96,16 +96,6 @@ def level_errors(stats, refs):
     return out
 
 
-def up_crossings(t, y, level, hyst):
-    """Upward crossings of level, re-armed only after y fell below level - hyst."""
-    return fstats.crossings(t, y, level, hyst)
-
-
-def periodic(t, y):
-    """Turek & Hron's mean = (max + min) / 2, amplitude, frequency over the whole periods."""
-    return fstats.turek_hron(t, y, hysteresis=0.1)
-
-
 err = fstats.relative_error_percent
 
 

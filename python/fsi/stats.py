@@ -43,8 +43,8 @@ import numpy as np
 __all__ = [
     "StatsError", "finite", "select_window", "last_seconds", "last_periods", "time_mean", "midrange",
     "amplitude", "crossings", "zero_crossing_frequency", "fft_frequency", "harmonic_amplitudes",
-    "periodic_stats", "turek_hron", "by_period", "moving_average", "turek_hron_table", "settling_time", "peak", "phase_lag", "signal_metrics",
-    "compare", "compare_values", "relative_error_percent",
+    "periodic_stats", "turek_hron", "by_period", "moving_average", "turek_hron_table", "settling_time", "peak",
+    "phase_lag", "signal_metrics", "compare", "compare_values", "relative_error_percent",
 ]
 
 _trapz = getattr(np, "trapezoid", None) or np.trapz
