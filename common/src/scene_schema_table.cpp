@@ -59,6 +59,11 @@ std::vector<Key> coupling_keys() {
           .req()
           .values({"1", "2"}),
       number("gamma_n1", "Nitsche penalty gamma_N1 (the Robin parameter)").req().ge(0),
+      number("fluid_penalty",
+             "the fluid's Nitsche penalty gamma_f (weak v_f = v_s); default gamma_n1 (the paper: one parameter). "
+             "Set apart, Algorithm 2's converged solution does not depend on gamma_n1; Algorithm 1 uses gamma_f only")
+          .def("gamma_n1")
+          .ge(0),
       number("gamma_n2", "Nitsche symmetry switch: +1 symmetric, -1 unsymmetric (the paper)")
           .def("-1")
           .values({"1", "-1"}),

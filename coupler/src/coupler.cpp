@@ -54,10 +54,17 @@ Coupler::Coupler(SolidModel& solid, FluidModel& fluid, const Scene& scene, std::
 Eigen::VectorXd Coupler::robin_force(const Eigen::VectorXd& traction, const Eigen::VectorXd& velocity_integral,
                                      const Eigen::VectorXd& solid_velocity,
                                      const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
-  const double gamma = settings_.nitsche_penalty;
-  if (settings_.algorithm == Algorithm::ImplicitSolidVelocity) return traction - gamma * velocity_integral;
-  if (gamma == 0) return traction;
-  return traction + gamma * (apply_nodal(algorithm1_mass(solid_displacement, mapped_mass), solid_velocity) - velocity_integral);
+  // traction = H^T f_sigma = H^T R + gamma_f (H^T f_v - M_G v_s): the fluid's force with its
+  // penalty gamma_f. Algorithm 2: F* = H^T R - gamma_N1 M_G v_s (the solid adds gamma_N1 C v);
+  // Algorithm 1: F* = H^T R + gamma_f (M_A1 - M_G) v_s (zero extra with the consistent M_A1).
+  const double gamma = settings_.nitsche_penalty, gamma_f = settings_.fluid_penalty;
+  if (settings_.algorithm == Algorithm::ImplicitSolidVelocity) {
+    if (gamma_f == gamma) return traction - gamma * velocity_integral;
+    return traction - gamma_f * velocity_integral +
+           (gamma_f - gamma) * apply_nodal(physical_mass(solid_displacement, mapped_mass), solid_velocity);
+  }
+  if (gamma_f == 0) return traction;
+  return traction + gamma_f * (apply_nodal(algorithm1_mass(solid_displacement, mapped_mass), solid_velocity) - velocity_integral);
 }
 
 NodalMatrix Coupler::algorithm1_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
@@ -267,7 +274,7 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   {
     Timer t(times_.fluid);
     fluid_.configure(scene_.section("fluid"),
-                     FluidSetup{time.dt, time.end, gamma, settings_.nitsche_symmetry,
+                     FluidSetup{time.dt, time.end, settings_.fluid_penalty, settings_.nitsche_symmetry,
                                 time.output_every > 0 ? vtk_dir : std::filesystem::path()});
   }
   solid_interface_ = solid_.interface();
@@ -317,6 +324,7 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
               solid_.name());
   }
   data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
+                      {"fluid_penalty", settings_.fluid_penalty},
                       {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
                       {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
                       {"acceleration", to_string(settings_.acceleration)},
@@ -329,6 +337,9 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
   log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
             to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
             settings_.tolerance, ns, fluid_interface.nodes());
+  if (settings_.fluid_penalty != gamma)
+    log->info("the fluid's Nitsche penalty gamma_f = {} is set apart from gamma_N1{}", settings_.fluid_penalty,
+              implicit ? "" : " (Algorithm 1 uses gamma_f only: gamma_N1 has no effect)");
 }
 
 void Coupler::write_output(Run& r, const StepInfo& info, const InterfaceFields& fields) {
@@ -624,12 +635,13 @@ Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
     it.mass = map_mass(r, it.loads);
     const Eigen::VectorXd fs = map_.to_solid(it.loads.traction_force), fv = map_.to_solid(it.loads.velocity_integral);
     const Eigen::VectorXd f_star = robin_force(fs, fv, s.interface_velocity, s.interface_displacement, it.mass);
-    // The physical traction H^T R = f_sigma - gamma (f_v - M_f v_s) (the fluid's reaction,
+    // The physical traction H^T R = f_sigma - gamma_f (f_v - M_f v_s) (the fluid's reaction,
     // without its penalty part), and its mismatch with what the solid felt: its load
     // F^(k) minus its own Robin damping gamma C v_s.
-    it.traction = gamma > 0 ? Eigen::VectorXd(fs - gamma * (fv - apply_nodal(physical_mass(s.interface_displacement, it.mass),
-                                                                              s.interface_velocity)))
-                            : fs;
+    const double gamma_f = settings_.fluid_penalty;
+    it.traction = gamma_f > 0 ? Eigen::VectorXd(fs - gamma_f * (fv - apply_nodal(physical_mass(s.interface_displacement, it.mass),
+                                                                                  s.interface_velocity)))
+                              : fs;
     traction_change = it.traction + step.force;
     if (it.damping.rows() > 0) traction_change -= gamma * apply_nodal(it.damping, s.interface_velocity);
     // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
@@ -792,11 +804,12 @@ void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::strin
   Eigen::VectorXd load = last.force_applied;
   if (last.damping.rows() > 0) load -= gamma * apply_nodal(last.damping, v);
   double uncancelled = 0;
-  if (gamma > 0) {
+  const double g = r.implicit ? gamma : settings_.fluid_penalty;  // the parameter of C's term
+  if (g > 0) {
     const NodalMatrix m_phys = physical_mass(s.interface_displacement, last.mass);
     const NodalMatrix c_cfg = r.implicit ? solid_damping_mass(last.mass)
                                          : algorithm1_mass(s.interface_displacement, last.mass);
-    uncancelled = gamma * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
+    uncancelled = g * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
   }
   st.work_uncancelled += uncancelled;
   row["coupling.power_solid"] = load.dot(dd) / r.time.dt;

@@ -29,6 +29,11 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   c.algorithm = static_cast<Algorithm>(algorithm);
   c.nitsche_penalty = s.get<double>("gamma_n1");
   if (c.nitsche_penalty < 0) s.fail("gamma_n1", "must be >= 0");
+  c.fluid_penalty = s.get<double>("fluid_penalty", c.nitsche_penalty);
+  if (c.fluid_penalty < 0) s.fail("fluid_penalty", "must be >= 0");
+  if (c.fluid_penalty == 0 && c.nitsche_penalty > 0)
+    s.fail("fluid_penalty", "must be > 0 when gamma_n1 > 0 (the fluid imposes the solid's velocity by Nitsche's "
+                            "method with this penalty)");
   c.nitsche_symmetry = s.get<double>("gamma_n2", -1.0);
   if (c.nitsche_symmetry != 1.0 && c.nitsche_symmetry != -1.0) s.fail("gamma_n2", "must be +1 or -1");
   c.relaxation = s.get<double>("relaxation");

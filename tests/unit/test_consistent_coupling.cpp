@@ -221,6 +221,25 @@ TEST(ConsistentCoupling, ForkedFromAlgorithm2IntoAlgorithm1GivesTheSameSteps) {
   EXPECT_LT(max_relative_difference(tail, a1.tip_y), 1e-8);
 }
 
+// With the fluid's penalty gamma_f set apart (coupling.fluid_penalty), the converged coupled
+// solution is the fluid's Nitsche solution with gamma_f whatever Algorithm 2's Robin parameter
+// gamma_N1: 100 and 3000 give Algorithm 1's history at gamma_f; with one parameter they differ.
+TEST(ConsistentCoupling, ConvergedAlgorithm2DoesNotDependOnGammaN1WhenTheFluidPenaltyIsSetApart) {
+  const std::string apart = "  fluid_penalty: 1000\n";
+  const Result a1 = run(1, 1000), low = run(2, 100, apart), high = run(2, 3000, apart);
+  const Result low_one = run(2, 100), high_one = run(2, 3000);
+  for (const Result* r : {&a1, &low, &high, &low_one, &high_one}) {
+    ASSERT_EQ(r->outcome.status, "completed") << r->outcome.reason;
+    ASSERT_EQ(r->tip_y.size(), 20u);
+  }
+  EXPECT_LT(max_relative_difference(a1.tip_y, low.tip_y), 1e-8);
+  EXPECT_LT(max_relative_difference(a1.tip_y, high.tip_y), 1e-8);
+  for (double w : low.uncancelled) EXPECT_EQ(w, 0.0);
+  for (double w : high.uncancelled) EXPECT_EQ(w, 0.0);
+  // One parameter (the paper's): gamma_N1 is the fluid's penalty too, and the answer moves.
+  EXPECT_GT(max_relative_difference(low_one.tip_y, high_one.tip_y), 1e-4);
+}
+
 TEST(ConsistentCoupling, TheSolidsOwnMassLeavesAnUncancelledTermThatChangesTheAnswer) {
   const Result consistent = run(2, 1000), own = run(2, 1000, "  robin_mass: solid\n");
   ASSERT_EQ(own.outcome.status, "completed") << own.outcome.reason;

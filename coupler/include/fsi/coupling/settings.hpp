@@ -44,6 +44,10 @@ struct ConvergenceMeasure {
 struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
   double nitsche_penalty = 0;     // gamma_N1 >= 0
+  // The fluid's Nitsche penalty gamma_f (its weak no-slip v_f = v_s on the interface). The
+  // paper uses one parameter: gamma_f = gamma_N1 (the default). Set apart, the converged
+  // coupled solution no longer depends on the Robin parameter gamma_N1 of Algorithm 2.
+  double fluid_penalty = 0;
   double nitsche_symmetry = -1;   // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
   double relaxation = 1;          // beta in (0, 1]
   Predictor predictor = Predictor::Previous;  // F^(1)_{n+1} = F_n (the paper)
