@@ -137,7 +137,7 @@ class FlagSolid:
 
     EDGE_SETS = ("left", "right", "bottom", "top")
 
-    def __init__(self, section, dt, interface_damping, log=print):
+    def __init__(self, section, dt, interface_damping, log=print, element=None):
         self.log = log
         s = Section(section, "solid")
         model = s.get("model", "fenics")
@@ -146,17 +146,22 @@ class FlagSolid:
         self.dt = dt
         self.gamma = float(interface_damping)
 
-        # 1. The discretisation (solid.fenics; without it: Q1 quadrilaterals with 2 x 2 Gauss
-        #    points, solid_server's own element, so that a scene written for solid_server gives
-        #    its numbers).
+        # 1. The discretisation: solid.fenics, else `element` (the server's command line), else
+        #    Q1 quadrilaterals with 2 x 2 Gauss points, solid_server's own element, so that a
+        #    scene written for solid_server gives its numbers.
+        element = {k: v for k, v in (element or {}).items() if v is not None}
         fe = s.child("fenics")
-        self.cell = fe.choice("cell", "quadrilateral", ("quadrilateral", "triangle"))
-        self.degree = fe.integer("degree", 1, minimum=1)
+        self.cell = fe.choice("cell", element.get("cell", "quadrilateral"), ("quadrilateral", "triangle"))
+        self.degree = fe.integer("degree", element.get("degree", 1), minimum=1)
         if self.cell == "quadrilateral" and self.degree != 1:
             raise SceneError("'solid.fenics.degree' must be 1 on quadrilaterals (legacy DOLFIN cannot evaluate Q2 "
                              "at a probe point); use 'cell: triangle' for higher degrees")
-        diagonal = fe.choice("diagonal", "crossed", ("crossed", "right", "left", "right/left", "left/right"))
-        qdeg = fe.integer("quadrature_degree", 2 if self.cell == "quadrilateral" else 2 * self.degree, minimum=1)
+        diagonal = fe.choice("diagonal", element.get("diagonal", "crossed"),
+                             ("crossed", "right", "left", "right/left", "left/right"))
+        qdeg = fe.integer("quadrature_degree", element.get("quadrature_degree",
+                                                           2 if self.cell == "quadrilateral" else 2 * self.degree),
+                          minimum=1)
+        self.diagonal, self.quadrature_degree = diagonal, qdeg
         fe.check_all_used()
         element = s.get("element", "q4")
         if element != "q4":
@@ -258,8 +263,9 @@ class FlagSolid:
         else:  # Bonet & Wood, plane strain: tr C includes C33 = 1
             J = df.det(F)
             W = 0.5 * mu * (df.tr(F.T * F) + 1 - 3) - mu * df.ln(J) + 0.5 * lam * df.ln(J) ** 2
-        self.f_int_form = df.derivative(W * dx, self.u, w)
-        self.k_form = df.derivative(self.f_int_form, self.u, du)
+        f_int = df.derivative(W * dx, self.u, w)
+        # compiled once (df.assemble of a UFL form would hash it again at every call)
+        self.f_int_form, self.k_form = df.Form(f_int), df.Form(df.derivative(f_int, self.u, du))
         t0 = _time.perf_counter()
         self.M = self._csr(df.assemble(rho * df.inner(du, w) * dx))
         gravity = s.vector2("gravity", [0.0, 0.0])
@@ -339,6 +345,7 @@ class FlagSolid:
         self.solved = False
         self.K = df.PETScMatrix()
         self.R = df.PETScVector()
+        self._u_array = df.as_backend_type(self.u.vector()).vec().array
 
     # -- helpers ----------------------------------------------------------------------------
     @staticmethod
@@ -453,8 +460,7 @@ class FlagSolid:
     def _assemble(self, d, f, cm, a_hist, cv, v_hist):
         """Residual R(d) and tangent J(d) on the free dofs:
         R = F_int(d) + M (cm d + a_hist) + M_fs (cv d + v_hist) - f,  J = K(d) + cm M + cv M_fs."""
-        self.u.vector().set_local(d)
-        self.u.vector().apply("insert")
+        self._u_array[:] = d  # the PETSc vector's own array (serial): no assembly of the vector
         df.assemble(self.f_int_form, tensor=self.R)
         df.assemble(self.k_form, tensor=self.K)
         r = self.R.get_local() - f
