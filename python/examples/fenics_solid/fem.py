@@ -254,22 +254,25 @@ class FlagSolid:
         self.u = df.Function(self.V)
         w, du = df.TestFunction(self.V), df.TrialFunction(self.V)
         dx = df.dx(metadata={"quadrature_degree": qdeg})
+        # Material parameters as Constants, not literals: the compiled forms (dijitso's cache)
+        # are then shared by every material, density and load.
+        lam_c, mu_c, rho_c = df.Constant(lam), df.Constant(mu), df.Constant(rho)
         I = df.Identity(2)
         H = df.grad(self.u)
         F = I + H
         E = 0.5 * (H + H.T + H.T * H)  # from H, not F^T F - I: full relative accuracy at tiny strains
         if law == "saint_venant_kirchhoff":
-            W = 0.5 * lam * df.tr(E) ** 2 + mu * df.inner(E, E)
+            W = 0.5 * lam_c * df.tr(E) ** 2 + mu_c * df.inner(E, E)
         else:  # Bonet & Wood, plane strain: tr C includes C33 = 1
             J = df.det(F)
-            W = 0.5 * mu * (df.tr(F.T * F) + 1 - 3) - mu * df.ln(J) + 0.5 * lam * df.ln(J) ** 2
+            W = 0.5 * mu_c * (df.tr(F.T * F) + 1 - 3) - mu_c * df.ln(J) + 0.5 * lam_c * df.ln(J) ** 2
         f_int = df.derivative(W * dx, self.u, w)
         # compiled once (df.assemble of a UFL form would hash it again at every call)
         self.f_int_form, self.k_form = df.Form(f_int), df.Form(df.derivative(f_int, self.u, du))
         t0 = _time.perf_counter()
-        self.M = self._csr(df.assemble(rho * df.inner(du, w) * dx))
+        self.M = self._csr(df.assemble(rho_c * df.inner(du, w) * dx))
         gravity = s.vector2("gravity", [0.0, 0.0])
-        dead = df.assemble(rho * df.inner(df.Constant(gravity), w) * dx).get_local()
+        dead = df.assemble(rho_c * df.inner(df.Constant(gravity), w) * dx).get_local()
         ds = df.Measure("ds", domain=self.mesh, subdomain_data=self.markers)
         tractions = s.get("tractions", []) or []
         if not isinstance(tractions, list):
