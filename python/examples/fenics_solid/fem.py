@@ -495,7 +495,7 @@ class FlagSolid:
                 break
             Jff = J[self.free][:, self.free].tocsc()
             try:
-                dd = spla.spsolve(Jff, -r, permc_spec="MMD_AT_PLUS_A")
+                dd = spla.spsolve(Jff, -r, permc_spec="COLAMD")  # MMD_AT_PLUS_A: 100 x slower on Q1 320 x 16
             except RuntimeError as e:  # singular
                 raise NewtonFailed(f"the tangent is singular ({e})") from None
             if not np.all(np.isfinite(dd)):
