@@ -49,6 +49,9 @@ The methods (positional arguments, in this order):
     Your state after the last accepted step, in your own format; with both, the server
     answers ``supports_checkpoint = true``. ``load`` raises ``InvalidArgument`` (or any
     exception) for a state it cannot use.
+``timings() -> dict`` (optional)
+    Cumulative wall seconds of your solver by category ("assembly", "linear_solve", ...),
+    sent with every AcceptReply: summary.json shows the last as ``wall_time.solid_breakdown``.
 ``write_output(step, time) -> list of file names`` (optional)
     With it, ``supports_output = true``.
 ``set_interface_mass(matrix)`` (optional, Algorithm 2)
@@ -422,6 +425,9 @@ class Server:
             probes = s.accept_step(int(a.step), float(a.time)) or {}
             for key, value in dict(probes).items():
                 reply.accept.probes[str(key)] = float(value)
+            if _implements(s, "timings"):
+                for key, value in dict(s.timings() or {}).items():
+                    reply.accept.timings[str(key)] = float(value)
             self._take_snapshot()
         elif body in ("save_checkpoint", "load_checkpoint"):
             self._need_configured(body)

@@ -143,6 +143,7 @@ class FlagSolid:
         model = s.get("model", "fenics")
         if model not in ("fem", "fenics"):
             raise SceneError(f"'solid.model' must be 'fem' or 'fenics' for this solid, got {model!r}")
+        t_setup = _time.perf_counter()
         self.dt = dt
         self.gamma = float(interface_damping)
 
@@ -334,7 +335,6 @@ class FlagSolid:
             self.probes.append((str(name), weights))
         self.output_every = s.integer("output_every", 1, minimum=0)
         s.check_all_used()
-        self.setup_seconds = _time.perf_counter() - t0
 
         # 9. State: at rest, undeformed; Newmark's consistent a_0 = M^-1 F_dead.
         z = np.zeros(self.n)
@@ -346,6 +346,7 @@ class FlagSolid:
         self.d, self.v, self.a, self.f = self.d_n.copy(), self.v_n.copy(), self.a_n.copy(), self.f_n.copy()
         self.newton_iterations = 0
         self.solved = False
+        self.timings = {"setup": _time.perf_counter() - t_setup, "assembly": 0.0, "linear_solve": 0.0, "step": 0.0}
         self.K = df.PETScMatrix()
         self.R = df.PETScVector()
         self._u_array = df.as_backend_type(self.u.vector()).vec().array
@@ -463,9 +464,11 @@ class FlagSolid:
     def _assemble(self, d, f, cm, a_hist, cv, v_hist):
         """Residual R(d) and tangent J(d) on the free dofs:
         R = F_int(d) + M (cm d + a_hist) + M_fs (cv d + v_hist) - f,  J = K(d) + cm M + cv M_fs."""
+        t0 = _time.perf_counter()
         self._u_array[:] = d  # the PETSc vector's own array (serial): no assembly of the vector
         df.assemble(self.f_int_form, tensor=self.R)
         df.assemble(self.k_form, tensor=self.K)
+        self.timings["assembly"] += _time.perf_counter() - t0
         r = self.R.get_local() - f
         J = self._csr(self.K)
         if cm:
@@ -493,11 +496,14 @@ class FlagSolid:
                 return it, res
             if it == self.max_iterations:
                 break
+            t0 = _time.perf_counter()
             Jff = J[self.free][:, self.free].tocsc()
             try:
                 dd = spla.spsolve(Jff, -r, permc_spec="COLAMD")  # MMD_AT_PLUS_A: 100 x slower on Q1 320 x 16
             except RuntimeError as e:  # singular
                 raise NewtonFailed(f"the tangent is singular ({e})") from None
+            finally:
+                self.timings["linear_solve"] += _time.perf_counter() - t0
             if not np.all(np.isfinite(dd)):
                 raise NewtonFailed(f"the Newton increment is not finite (iteration {it + 1})")
             d[self.free] += dd
@@ -515,6 +521,13 @@ class FlagSolid:
     def solve(self, dt, interface_force):
         """Solve the step for this interface force (2 per interface node, interleaved), from
         the accepted state. Returns the interface displacement and velocity (interleaved)."""
+        t0 = _time.perf_counter()
+        try:
+            return self._solve(dt, interface_force)
+        finally:
+            self.timings["step"] += _time.perf_counter() - t0
+
+    def _solve(self, dt, interface_force):
         f = self.f_dead.copy()
         f[self.if_x] += interface_force[0::2]
         f[self.if_y] += interface_force[1::2]

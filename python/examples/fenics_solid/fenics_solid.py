@@ -106,6 +106,11 @@ class FenicsSolid(fs.Solid):
         probes["newton_iterations"] = self.model.newton_iterations
         return probes
 
+    def timings(self):
+        """Cumulative seconds (setup, step = every solve, assembly and linear_solve inside it),
+        shown as wall_time.solid_breakdown in summary.json."""
+        return dict(self.model.timings)
+
     def save(self):
         """SaveCheckpoint: d, v, a (and the step before, for BDF2) of the accepted step."""
         return self.model.save()
