@@ -4,8 +4,10 @@ You write the physics; this module speaks the protocol (proto/fsi/v1/coupling.pr
 the launcher's command line (``--bind ENDPOINT --port-file FILE [--curve-keys DIR]``),
 the ZeroMQ socket, the atomic port file, version and order checks, error replies,
 sequence numbers, Hello capabilities, sessions, ``--set`` overrides applied to the scene,
-restarting every coupling iteration from the last accepted state, checkpoints, SIGTERM.
+restarting every coupling iteration from the last accepted state, checkpoints, SIGTERM,
+one coupler at a time (others get BUSY).
 
+    import sys
     import fsi.server as fs
 
     class PointMass(fs.Solid):
@@ -23,7 +25,7 @@ restarting every coupling iteration from the last accepted state, checkpoints, S
         def accept_step(self, step, time):
             return {"d_x": self.d[0]}
 
-    fs.serve(PointMass)
+    sys.exit(fs.serve(PointMass))     # 0 after Stop, 130 after SIGTERM, 3 after --idle-timeout
 
 The methods (positional arguments, in this order):
 
@@ -47,6 +49,9 @@ The methods (positional arguments, in this order):
     Your state after the last accepted step, in your own format; with both, the server
     answers ``supports_checkpoint = true``. ``load`` raises ``InvalidArgument`` (or any
     exception) for a state it cannot use.
+``timings() -> dict`` (optional)
+    Cumulative wall seconds of your solver by category ("assembly", "linear_solve", ...),
+    sent with every AcceptReply: summary.json shows the last as ``wall_time.solid_breakdown``.
 ``write_output(step, time) -> list of file names`` (optional)
     With it, ``supports_output = true``.
 ``set_interface_mass(matrix)`` (optional, Algorithm 2)
@@ -279,7 +284,10 @@ class Server:
             raise ValueError(f"{self.name}: restart = 'save' needs save() and load()")
         self.restart = mode
         self.solver_errors = (SolverFailed,) + tuple(getattr(solid, "solver_errors", ()) or ())
-        self.session = None
+        self.session = None        # the open session's id (Hello.session), None when none is open
+        self.session_peer = None   # the connection it came on (serve(): the ROUTER identity)
+        self.session_client = ""
+        self.session_since = ""
         self.requests = 0
         self._reset()
 
@@ -304,8 +312,22 @@ class Server:
         self._dirty = False
 
     # -- requests ----------------------------------------------------------------------
-    def handle_frames(self, frames):
-        """frames: the message parts a REP socket received (the envelope stripped)."""
+    def peer_gone(self, peer):
+        """The connection of ``peer`` closed: if it held the session (the coupler died), the
+        session ends and the configuration is forgotten; the next coupler says Hello again."""
+        if self.session_peer is None or peer != self.session_peer:
+            return False
+        _log(self.name, f"session '{self.session}' of '{self.session_client}' ended: its connection closed")
+        self._close_session()
+        self._reset()
+        return True
+
+    def _close_session(self):
+        self.session, self.session_peer, self.session_client, self.session_since = None, None, "", ""
+
+    def handle_frames(self, frames, peer=None):
+        """frames: the message parts after the envelope (what a REP socket delivers); ``peer``:
+        who sent them (any hashable; None = a socket that has one client anyway)."""
         if len(frames) != 1:
             reply = pb.Reply(protocol_version=VERSION)
             reply.error.code = pb.Error.MALFORMED
@@ -320,23 +342,29 @@ class Server:
             reply.error.code = pb.Error.MALFORMED
             reply.error.message = f"message of {len(frames[0])} bytes is not a fsi.v1.Request"
             return reply.SerializeToString(), False
-        reply, stop = self.handle(request)
+        reply, stop = self.handle(request, peer)
         return reply.SerializeToString(), stop
 
-    def handle(self, request):
-        """One parsed fsi.v1.Request -> (fsi.v1.Reply, stop)."""
+    def handle(self, request, peer=None):
+        """One parsed fsi.v1.Request -> (fsi.v1.Reply, stop). While a session is open (from
+        Hello to Stop, or until its connection closes: ``peer_gone``), a request of another
+        ``peer`` gets Error BUSY naming the session, as the C++ servers answer."""
         self.requests += 1
         start = _time.perf_counter()
         reply = pb.Reply(protocol_version=VERSION, sequence=request.sequence)
         if request.protocol_version != VERSION:
             return self._error(reply, pb.Error.VERSION_MISMATCH, f"protocol version mismatch: request has "
                                f"{request.protocol_version}, this server speaks {VERSION}"), False
+        if self.session_peer is not None and peer is not None and peer != self.session_peer:
+            return self._error(reply, pb.Error.BUSY, f"this server is in session '{self.session}' with "
+                               f"'{self.session_client}' (since {self.session_since}); it serves one coupler at "
+                               f"a time"), False
         body = request.WhichOneof("body")
         if body is None:
             return self._error(reply, pb.Error.MALFORMED, "request has no body"), False
         stop = False
         try:
-            stop = self._dispatch(body, request, reply)
+            stop = self._dispatch(body, request, reply, peer)
         except InvalidArgument as e:
             self._error(reply, pb.Error.INVALID_ARGUMENT, str(e))
         except _BadSequence as e:
@@ -366,12 +394,15 @@ class Server:
                                    f"({self.configure_failure})")
             raise _BadSequence(f"'{body}' before 'configure'")
 
-    def _dispatch(self, body, request, reply):
+    def _dispatch(self, body, request, reply, peer=None):
         s = self.solid
         if body == "hello":
             h = request.hello
             self.session = h.session or "unnamed"
-            _log(self.name, f"session '{self.session}' of '{h.client_name or 'a client'}'")
+            self.session_peer = peer
+            self.session_client = h.client_name or "a client"
+            self.session_since = _time.strftime("%H:%M:%S")
+            _log(self.name, f"session '{self.session}' of '{self.session_client}'")
             r = reply.hello
             r.kind = pb.SERVER_KIND_SOLID
             r.server_name = self.name
@@ -394,6 +425,9 @@ class Server:
             probes = s.accept_step(int(a.step), float(a.time)) or {}
             for key, value in dict(probes).items():
                 reply.accept.probes[str(key)] = float(value)
+            if _implements(s, "timings"):
+                for key, value in dict(s.timings() or {}).items():
+                    reply.accept.timings[str(key)] = float(value)
             self._take_snapshot()
         elif body in ("save_checkpoint", "load_checkpoint"):
             self._need_configured(body)
@@ -419,7 +453,7 @@ class Server:
         elif body == "stop":
             _log(self.name, f"stop ({request.stop.reason or 'no reason given'})")
             reply.stop.SetInParent()
-            self.session = None
+            self._close_session()
             return True
         else:
             raise Unsupported(f"a solid server does not handle '{body}'")
@@ -547,12 +581,23 @@ def argument_parser(description=None):
     return p
 
 
-class _Interrupted(Exception):
-    pass
+_SIGNALLED = []
 
 
 def _on_signal(signum, frame):
-    raise _Interrupted(signum)
+    # Only a flag, as the C++ servers: the request being computed is finished and answered,
+    # then serve() returns 130. (An exception raised here would surface inside the solid's
+    # code and be answered as an INTERNAL error, and the server would go on.)
+    _SIGNALLED.append(signum)
+
+
+def _split_envelope(frames):
+    """ROUTER frames -> (envelope, payload frames): the identity and every frame up to and
+    including the empty delimiter, if there is one."""
+    for i in range(1, len(frames)):
+        if len(frames[i]) == 0:
+            return frames[:i + 1], frames[i + 1:]
+    return frames[:1], frames[1:]
 
 
 def write_port_file(path, endpoint):
@@ -563,10 +608,16 @@ def write_port_file(path, endpoint):
 
 
 def serve(solid, argv=None, parser=None, args=None):
-    """Serve one solid until Stop; returns the exit code (0 after Stop, 130 after SIGTERM or
-    SIGINT, 3 after --idle-timeout). ``solid``: an instance, a class (instantiated without
-    arguments), or a function of the parsed arguments returning an instance."""
+    """Serve one solid until Stop; returns the exit code: 0 after Stop, 130 after SIGTERM or
+    SIGINT (the request in progress is answered first), 3 after --idle-timeout. Pass it on:
+    ``sys.exit(fs.serve(MySolid))``. ``solid``: an instance, a class (instantiated without
+    arguments), or a function of the parsed arguments returning an instance.
+
+    One ROUTER socket, like the C++ servers: a Hello opens a session for its connection; the
+    requests of any other client get BUSY until Stop or until that connection closes (the
+    coupler died: the configuration is then forgotten)."""
     import zmq
+    from zmq.utils.monitor import recv_monitor_message
 
     if args is None:
         args = (parser or argument_parser()).parse_args(argv)
@@ -577,8 +628,10 @@ def serve(solid, argv=None, parser=None, args=None):
     server = Server(solid)
     name = server.name
     ctx = zmq.Context.instance()
-    sock = ctx.socket(zmq.REP)  # REP strips and restores the coupler's DEALER envelope
+    sock = ctx.socket(zmq.ROUTER)  # [identity, "", request] in, [identity, "", reply] out
     sock.setsockopt(zmq.LINGER, 1000)
+    monitor = sock.get_monitor_socket(zmq.EVENT_DISCONNECTED)  # a coupler's connection closed
+    peer_of_fd = {}  # the connection (file descriptor) each peer's requests came on
     auth = None
     if args.curve_keys:  # encrypted; only the clients whose *.key is in the folder
         import zmq.auth
@@ -599,29 +652,58 @@ def serve(solid, argv=None, parser=None, args=None):
     if args.port_file:
         write_port_file(args.port_file, endpoint)
     _log(name, f"listening on {endpoint}")
+    def drain_disconnects(wait_ms):
+        while monitor.poll(wait_ms):
+            wait_ms = 0
+            event = recv_monitor_message(monitor)
+            peer = peer_of_fd.pop(event.get("value"), None)
+            if event.get("event") == zmq.EVENT_DISCONNECTED and peer is not None:
+                server.peer_gone(peer)
+
+    del _SIGNALLED[:]
     old = {s: signal.signal(s, _on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
     code = 0
     try:
         idle_since = _time.monotonic()
-        while True:
-            if not sock.poll(200):
+        while not _SIGNALLED:
+            ready = sock.poll(200)
+            drain_disconnects(0)
+            if not ready:
                 if args.idle_timeout > 0 and _time.monotonic() - idle_since > args.idle_timeout:
                     _log(name, f"no request for {args.idle_timeout:g} s, exiting")
                     code = 3
                     break
                 continue
-            frames = sock.recv_multipart()
+            frames = sock.recv_multipart(copy=False)
             idle_since = _time.monotonic()
-            data, stop = server.handle_frames(frames)
-            sock.send(data)
+            if len(frames) < 2:
+                continue  # no identity: nobody to answer
+            peer = frames[0].bytes
+            # A closed connection whose event is still in flight must be seen before a new
+            # peer's request is judged (a coupler restarted after its predecessor died).
+            known = peer in peer_of_fd.values()
+            drain_disconnects(100 if not known and peer_of_fd else 0)
+            try:
+                fd = frames[-1].get(zmq.SRCFD)
+            except zmq.ZMQError:
+                fd = -1
+            if fd >= 0:
+                for f in [f for f, p in peer_of_fd.items() if p == peer and f != fd]:
+                    del peer_of_fd[f]
+                peer_of_fd[fd] = peer
+            envelope, payload = _split_envelope([f.bytes for f in frames])
+            data, stop = server.handle_frames(payload, peer)
+            sock.send_multipart(envelope + [data])
             if stop:
                 break
-    except _Interrupted as e:
-        _log(name, f"interrupted by signal {e.args[0]}, exiting")
-        code = 130
+        if _SIGNALLED:
+            _log(name, f"interrupted by signal {_SIGNALLED[0]}, exiting")
+            code = 130
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+        sock.disable_monitor()
+        monitor.close(linger=0)
         sock.close(linger=1000 if code == 0 else 0)
         if auth is not None:
             auth.stop()

@@ -1,0 +1,240 @@
+#!/usr/bin/python3
+"""The FEniCS solid (python/examples/fenics_solid, legacy DOLFIN) replaces solid_server
+through the protocol: `fsi run SCENE --solid-command "PYTHON fenics_solid.py ..."` with the
+coupler and a fluid that exerts no force (python/examples/fenics_solid/scenes/).
+
+--part static (ctest python.fenics_csm):
+  - CSM1 and CSM2 with P2 triangles on 40 x 2 crossed rectangles (1450 dofs): point A within
+    1 % of Turek & Hron (measured +0.08 / +0.03 % and +0.06 / +0.05 %);
+  - CSM1 with the default element (Q1, 2 x 2 Gauss points) on 80 x 4: solid_server's numbers
+    on the same scene, to 1e-9 relative (measured 4e-15), St. Venant-Kirchhoff and neo-Hookean
+    (the same element: a check of the interface, the probes, the laws and Newton);
+  - the same with the fsi package installed offline into a venv made with
+    --system-site-packages (DOLFIN from Debian), the example folder copied alone;
+  - checkpoints: 40 dynamic steps (Newmark) with checkpoints every 20; a run forked from the
+    step-20 checkpoint (`fsi run --from`) gives steps 21-40 exactly; a checkpoint of another
+    mesh is refused naming the difference.
+--part csm3 (ctest python.fenics_csm3):
+  - CSM3 to t = 10 (dt 0.005, Newmark, P2 on 40 x 2 'right', 810 dofs): mean, amplitude and
+    frequency of A's u_x and u_y over the last period within 1 % of Turek & Hron (measured
+    within 0.35 %).
+
+Exit 77 (ctest: skipped) when the Python has no dolfin (scripts/install-deps.sh installs
+python3-dolfin).
+
+    test_fenics_solid.py --bin BUILD/bin --source SRC --python PYTHON --part static|csm3 WORK
+"""
+import argparse
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--bin", required=True)
+ap.add_argument("--source", required=True)
+ap.add_argument("--python", required=True)
+ap.add_argument("--part", choices=("static", "csm3"), required=True)
+ap.add_argument("work")
+a = ap.parse_args()
+SRC = Path(a.source).resolve()
+FSI = str(Path(a.bin).resolve() / "fsi")
+SCENES = SRC / "python" / "examples" / "fenics_solid" / "scenes"
+SOLID = SRC / "python" / "examples" / "fenics_solid" / "fenics_solid.py"
+work = Path(a.work).resolve()
+shutil.rmtree(work, ignore_errors=True)
+work.mkdir(parents=True)
+failures = []
+
+p = subprocess.run([a.python, "-c", "import dolfin"], capture_output=True, text=True)
+if p.returncode != 0:
+    print(f"skipped: {a.python} cannot import dolfin (apt-get install python3-dolfin; scripts/install-deps.sh)")
+    sys.exit(77)
+
+REFERENCE = {"csm1": (-7.187e-3, -66.10e-3), "csm2": (-0.469e-3, -16.97e-3)}
+CSM3_REFERENCE = {"A_x": (-14.305, 14.305, 1.0995), "A_y": (-63.607, 65.160, 1.0995)}  # 1e-3 m, Hz
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what, flush=True)
+    if not ok:
+        failures.append(what)
+
+
+def fsi_run(scene, out, *sets, solid=None, extra=(), timeout=600):
+    cmd = [FSI, "run", str(scene), "--out", str(out)]
+    for s in sets:
+        cmd += ["--set", s]
+    if solid:
+        cmd += ["--solid-command", solid]
+    t0 = time.monotonic()
+    p = subprocess.run(cmd + list(extra), capture_output=True, text=True, timeout=timeout, cwd=work)
+    wall = time.monotonic() - t0
+    summary = {}
+    if (out / "summary.json").exists():
+        summary = json.load(open(out / "summary.json"))
+    return p, summary, wall
+
+
+def probes(out):
+    with open(out / "probes.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+
+
+def rel(x, ref):
+    """The error as the repository's tables give it: x / ref - 1 (+ = larger in magnitude)."""
+    return x / ref - 1.0
+
+
+def log_tail(out):
+    try:
+        return (out / "solid_server.log").read_text()[-800:]
+    except OSError:
+        return ""
+
+
+def last_period(t, y):
+    """solid_bench's statistic (bench/solid/solid_bench.cpp): the period between the last two
+    upward crossings of the midrange of the second half (10 % hysteresis); over it mean =
+    (max + min) / 2, amplitude = (max - min) / 2, frequency = 1 / period."""
+    n = len(t)
+    lo, hi = min(y[n // 2:]), max(y[n // 2:])
+    level, band = 0.5 * (hi + lo), 0.1 * (hi - lo)
+    ups, below = [], False
+    for i in range(1, n):
+        if y[i] < level - band:
+            below = True
+        if below and y[i - 1] < level <= y[i]:
+            ups.append(t[i - 1] + (level - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]))
+            below = False
+    t0, t1 = ups[-2], ups[-1]
+    ys = [v for s, v in zip(t, y) if t0 <= s <= t1]
+    return 0.5 * (max(ys) + min(ys)), 0.5 * (max(ys) - min(ys)), 1.0 / (t1 - t0)
+
+
+P2 = f"{a.python} {SOLID} --cell triangle --degree 2"
+timings = {}
+
+if a.part == "static":
+    # 1. CSM1 and CSM2 against Turek & Hron, P2 on 40 x 2 crossed.
+    for case in ("csm1", "csm2"):
+        out = work / f"{case}_p2"
+        p, summary, wall = fsi_run(SCENES / f"{case}.yaml", out, solid=P2)
+        timings[case] = wall
+        if p.returncode != 0:
+            check(False, f"{case}, FEniCS P2: exit {p.returncode} {(p.stderr + log_tail(out))[-800:]}")
+            continue
+        pr = probes(out)
+        ux, uy = pr["solid.A_x"][-1], pr["solid.A_y"][-1]
+        ex, ey = rel(ux, REFERENCE[case][0]), rel(uy, REFERENCE[case][1])
+        check(summary["servers"]["solid"]["name"].startswith("python fenics_solid.py") and abs(ex) < 0.01
+              and abs(ey) < 0.01,
+              f"{case}, FEniCS P2 40 x 2 crossed: A = ({ux:.5e}, {uy:.5e}) m, errors {100 * ex:+.2f} % / "
+              f"{100 * ey:+.2f} % (< 1 %), {wall:.1f} s")
+
+    # 2. The default element (Q1, 2 x 2 Gauss) = solid_server's, same scene, 80 x 4; the
+    #    neo-Hookean law too.
+    nh = ["solid.mesh.elements=[80, 4]", "solid.material.law=neo_hookean"]
+    p, _, _ = fsi_run(SCENES / "csm1.yaml", work / "csm1_nh_cpp", *nh)
+    p2, _, wall = fsi_run(SCENES / "csm1.yaml", work / "csm1_nh_q1", *nh, solid=f"{a.python} {SOLID}")
+    if p.returncode == 0 and p2.returncode == 0:
+        ref, got = probes(work / "csm1_nh_cpp"), probes(work / "csm1_nh_q1")
+        d = max(abs(rel(got[k][-1], ref[k][-1])) for k in ("solid.A_x", "solid.A_y"))
+        check(d <= 1e-9, f"csm1 neo-Hookean, FEniCS Q1 80 x 4 = solid_server 80 x 4: A_y {got['solid.A_y'][-1]:.10e} "
+              f"vs {ref['solid.A_y'][-1]:.10e}, max relative difference {d:.1e} (<= 1e-9), {wall:.1f} s")
+    else:
+        check(False, f"csm1 neo-Hookean: exit {p.returncode} / {p2.returncode} "
+              f"{(p.stderr + p2.stderr + log_tail(work / 'csm1_nh_q1'))[-800:]}")
+    q1 = ["solid.mesh.elements=[80, 4]"]
+    p, _, wall = fsi_run(SCENES / "csm1.yaml", work / "csm1_cpp", *q1)
+    ref = probes(work / "csm1_cpp") if p.returncode == 0 else None
+    check(ref is not None, f"csm1, solid_server 80 x 4: exit {p.returncode} {p.stderr[-300:] if ref is None else ''}")
+    p, _, wall = fsi_run(SCENES / "csm1.yaml", work / "csm1_q1", *q1, solid=f"{a.python} {SOLID}")
+    timings["csm1_q1"] = wall
+    got = probes(work / "csm1_q1") if p.returncode == 0 else None
+    if ref and got:
+        d = max(abs(rel(got[k][-1], ref[k][-1])) for k in ("solid.A_x", "solid.A_y"))
+        check(d <= 1e-9, f"csm1, FEniCS Q1 80 x 4 = solid_server 80 x 4: A_y {got['solid.A_y'][-1]:.10e} vs "
+              f"{ref['solid.A_y'][-1]:.10e}, max relative difference {d:.1e} (<= 1e-9), {wall:.1f} s")
+    else:
+        check(False, f"csm1, FEniCS Q1: exit {p.returncode} {(p.stderr + log_tail(work / 'csm1_q1'))[-800:]}")
+
+    # 3. The same from a venv with --system-site-packages and the package installed offline.
+    t0 = time.monotonic()
+    pkg, venv, solo = work / "pkg", work / "V", work / "solo"
+    shutil.copytree(SRC / "python", pkg, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
+    shutil.copytree(SOLID.parent, solo / "fenics_solid", ignore=shutil.ignore_patterns("__pycache__"))
+    env = dict(os.environ, PIP_NO_INDEX="1", PIP_DISABLE_PIP_VERSION_CHECK="1")
+    env.pop("PYTHONPATH", None)
+    p = subprocess.run([a.python, "-m", "venv", "--system-site-packages", str(venv)], capture_output=True, text=True)
+    p2 = subprocess.run([str(venv / "bin" / "pip"), "install", "-q", str(pkg)], capture_output=True, text=True,
+                        env=env, timeout=300)
+    check(p.returncode == 0 and p2.returncode == 0, f"venv --system-site-packages and pip install ./python: "
+          f"{p.stderr[-200:]} {p2.stderr[-300:]}")
+    out = work / "csm1_q1_venv"
+    p, summary, wall = fsi_run(SCENES / "csm1.yaml", out, *q1,
+                               solid=f"{venv / 'bin' / 'python'} {solo / 'fenics_solid' / 'fenics_solid.py'}")
+    timings["venv"] = time.monotonic() - t0
+    if p.returncode == 0 and got:
+        v = probes(out)
+        log = (out / "solid_server.log").read_text()
+        same = all(v[k] == got[k] for k in ("solid.A_x", "solid.A_y"))
+        check(same and "re-run" not in log and "running with" not in log,
+              f"csm1 Q1 from the venv: the same A ({v['solid.A_y'][-1]:.10e}), run by the venv's python, {wall:.1f} s")
+    else:
+        check(False, f"csm1 from the venv: exit {p.returncode} {(p.stderr + log_tail(out))[-800:]}")
+
+    # 4. Checkpoints: a fork from step 20 reproduces steps 21-40.
+    short = ["time.end=0.2", "time.checkpoint_every=20"]
+    P2R = P2 + " --diagonal right"
+    full, fork = work / "csm3_full", work / "csm3_fork"
+    p, _, wall = fsi_run(SCENES / "csm3.yaml", full, *short, solid=P2R)
+    timings["checkpoint_full"] = wall
+    ok = p.returncode == 0 and (full / "checkpoints" / "step_00000020").is_dir()
+    check(ok, f"csm3 to t = 0.2 with checkpoints every 20 steps: exit {p.returncode} "
+              f"{(p.stderr + log_tail(full))[-500:] if not ok else ''}")
+    if ok:
+        p, summary, wall = fsi_run(SCENES / "csm3.yaml", fork, *short, solid=P2R,
+                                   extra=["--from", str(full / "checkpoints" / "step_00000020")])
+        timings["checkpoint_fork"] = wall
+        if p.returncode == 0:
+            A, B = probes(full), probes(fork)
+            tail = {k: A[k][-len(B[k]):] if k in A else None for k in B}
+            n = len(B["time"])
+            diff = max(abs(x - y) for k in ("solid.A_x", "solid.A_y") for x, y in zip(tail[k], B[k]))
+            check(n >= 20 and B["time"][-20:] == A["time"][-20:] and diff == 0.0,
+                  f"forked from step 20: {n} rows, steps 21-40 of A equal the uninterrupted run's "
+                  f"(max |difference| {diff:.1e})")
+        else:
+            check(False, f"fork from step 20: exit {p.returncode} {(p.stderr + log_tail(fork))[-600:]}")
+        bad = work / "csm3_bad"
+        p, summary, wall = fsi_run(SCENES / "csm3.yaml", bad, *short, "solid.mesh.elements=[20, 1]", solid=P2R,
+                                   extra=["--from", str(full / "checkpoints" / "step_00000020")])
+        reason = summary.get("reason", "") + p.stderr
+        check(p.returncode == 1 and "this configuration is" in reason,
+              f"a checkpoint of another mesh is refused: exit {p.returncode}, "
+              f"{[line for line in reason.splitlines() if 'checkpoint' in line][:1]}")
+else:
+    out = work / "csm3_p2"
+    p, summary, wall = fsi_run(SCENES / "csm3.yaml", out, solid=P2 + " --diagonal right", timeout=900)
+    timings["csm3"] = wall
+    if p.returncode != 0:
+        check(False, f"csm3: exit {p.returncode} {(p.stderr + log_tail(out))[-800:]}")
+    else:
+        pr = probes(out)
+        t = pr["time"]
+        check(abs(t[-1] - 10.0) < 1e-9 and len(t) == 2000, f"csm3: {len(t)} steps to t = {t[-1]}")
+        for k, (m_ref, a_ref, f_ref) in CSM3_REFERENCE.items():
+            m, amp, f = last_period(t, [1e3 * v for v in pr[f"solid.{k}"]])
+            errs = (rel(m, m_ref), rel(amp, a_ref), rel(f, f_ref))
+            check(all(abs(e) < 0.01 for e in errs),
+                  f"csm3 {k}: {m:.3f} +/- {amp:.3f} [{f:.4f} Hz] (1e-3 m), errors "
+                  + ", ".join(f"{100 * e:+.2f} %" for e in errs) + " (< 1 %)")
+
+print("wall times: " + ", ".join(f"{k} {v:.1f} s" for k, v in timings.items()))
+sys.exit(1 if failures else 0)
