@@ -10,11 +10,6 @@
 namespace fsi::coupling {
 
 enum class Algorithm { ExplicitSolidVelocity = 1, ImplicitSolidVelocity = 2 };
-enum class Predictor { Previous, Linear };
-// How F^(k+1) follows from F^(k) and F*: the paper's constant relaxation, Aitken's dynamic
-// relaxation (Kuttler & Wall 2008) or interface quasi-Newton IQN-ILS (Degroote et al. 2009),
-// both beyond the paper and both starting each step with beta (acceleration.hpp).
-enum class Acceleration { Constant, Aitken, IqnIls };
 // The interface mass of the gamma_N1 terms on the solid's side: `consistent` = the fluid's
 // own M_f in the configuration of its last solve, mapped H^T M_f H (the terms cancel exactly
 // at convergence, any meshes, any deformation); `solid` = the solid's polyline int N^T N
@@ -46,8 +41,13 @@ struct CouplingSettings {
   double nitsche_penalty = 0;     // gamma_N1 >= 0
   double nitsche_symmetry = -1;   // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
   double relaxation = 1;          // beta in (0, 1]
-  Predictor predictor = Predictor::Previous;  // F^(1)_{n+1} = F_n (the paper)
-  Acceleration acceleration = Acceleration::Constant;
+  // F^(1)_{n+1} from the accepted forces: a name of predictor.hpp's registry ("previous" =
+  // F_n, the paper).
+  std::string predictor = "previous";
+  // How F^(k+1) follows from F^(k) and F*: a name of acceleration.hpp's registry ("constant" =
+  // the paper's beta; Aitken and the quasi-Newton schemes are beyond the paper and start each
+  // step with beta).
+  std::string acceleration = "constant";
   int reuse_steps = 8;            // IQN-ILS: secant pairs of the last N accepted steps are reused
   double iqn_filter = 1e-3;       // IQN-ILS: drop a column whose orthogonal remainder is below this share
   int max_iterations = 1;         // k_max
@@ -69,7 +69,6 @@ struct CouplingSettings {
 CouplingSettings read_coupling(const ConfigSection& section);
 
 std::string to_string(Algorithm a);
-std::string to_string(Acceleration a);
 std::string to_string(RobinMass m);
 
 }  // namespace fsi::coupling
