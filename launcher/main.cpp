@@ -38,6 +38,7 @@
 #include "check.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/version.hpp"
+#include "fsi/coupling/checkpoint.hpp"
 
 namespace fs = std::filesystem;
 
@@ -215,21 +216,10 @@ void finalize_summary(const fs::path& out, const fsi::Scene& scene, const std::s
   write_json_atomic(out / "summary.json", j);
 }
 
-// The newest complete checkpoint's manifest (null if none).
+// The newest complete checkpoint's manifest (null if none), as the coupler finds it.
 nlohmann::json newest_checkpoint(const fs::path& out) {
-  const fs::path dir = out / "checkpoints";
-  if (!fs::is_directory(dir)) return nullptr;
-  std::vector<fs::path> folders;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_directory() && e.path().filename().string().rfind("step_", 0) == 0 &&
-        e.path().extension() != ".tmp" && fs::exists(e.path() / "manifest.json"))
-      folders.push_back(e.path());
-  std::sort(folders.rbegin(), folders.rend());
-  for (const auto& f : folders) {
-    auto j = read_json(f / "manifest.json");
-    if (j.is_object()) return j;
-  }
-  return nullptr;
+  const auto c = fsi::coupling::CheckpointStore(out / "checkpoints", 1).newest();
+  return c ? c->manifest : nlohmann::json(nullptr);
 }
 
 struct Server {
@@ -272,45 +262,44 @@ struct RunOptions {
 };
 
 // --from PATH: the checkpoint folder (PATH itself when it holds a manifest.json, else the
-// newest complete one under PATH/checkpoints).
-fs::path fork_checkpoint(const std::string& from) {
+// newest complete one under PATH/checkpoints), checked as the coupler checks it.
+fsi::coupling::CheckpointStore::Loaded fork_checkpoint(const std::string& from) {
   const fs::path p(from);
-  if (fs::exists(p / "manifest.json")) return p;
+  if (fs::exists(p / "manifest.json")) {
+    try {
+      return fsi::coupling::CheckpointStore::read(p);
+    } catch (const std::exception& e) {
+      throw fsi::ConfigError(fmt::format("--from '{}': not a complete checkpoint ({})", from, e.what()));
+    }
+  }
   const fs::path dir = p / "checkpoints";
   if (!fs::is_directory(dir))
     throw fsi::ConfigError(fmt::format("--from '{}': neither a checkpoint (no manifest.json) nor a run folder with "
                                        "checkpoints/ (time.checkpoint_every > 0)",
                                        from));
-  std::vector<fs::path> found;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_directory() && e.path().filename().string().rfind("step_", 0) == 0 && fs::exists(e.path() / "manifest.json"))
-      found.push_back(e.path());
-  if (found.empty()) throw fsi::ConfigError(fmt::format("--from '{}': no complete checkpoint in {}", from, dir.string()));
-  std::sort(found.begin(), found.end());
-  return found.back();
+  std::vector<std::string> skipped;
+  auto found = fsi::coupling::CheckpointStore(dir, 1).newest(&skipped);
+  if (!found)
+    throw fsi::ConfigError(fmt::format("--from '{}': no complete checkpoint in {}{}", from, dir.string(),
+                                       skipped.empty() ? std::string() : " (" + skipped.front() + ")"));
+  return *found;
 }
 
 // Copies the checkpoint into OUT/checkpoints/ and writes OUT/forked_from.json: the coupler
 // then continues from it with the scene as given now (changed keys allowed and listed).
 void prepare_fork(const std::string& from, const fs::path& out) {
-  const fs::path ckpt = fork_checkpoint(from);
-  nlohmann::json manifest;
-  try {
-    std::ifstream in(ckpt / "manifest.json");
-    manifest = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw fsi::ConfigError(fmt::format("--from: {} does not parse ({})", (ckpt / "manifest.json").string(), e.what()));
-  }
+  const auto ckpt = fork_checkpoint(from);
+  const nlohmann::json& manifest = ckpt.manifest;
   fs::create_directories(out / "checkpoints");
-  fs::copy(ckpt, out / "checkpoints" / ckpt.filename(), fs::copy_options::recursive);
-  const nlohmann::json fork = {{"checkpoint", fs::absolute(ckpt).string()},
+  fs::copy(ckpt.dir, out / "checkpoints" / ckpt.dir.filename(), fs::copy_options::recursive);
+  const nlohmann::json fork = {{"checkpoint", fs::absolute(ckpt.dir).string()},
                                {"step", manifest.value("step", 0)},
                                {"time", manifest.value("time", 0.0)},
                                {"iterations", manifest.value("iterations", 0)},
                                {"scene_file", manifest.value("scene_file", std::string())},
                                {"overrides", manifest.value("overrides", nlohmann::json::array())}};
   std::ofstream(out / "forked_from.json") << fork.dump(2) << "\n";
-  fsi::logger("fsi")->info("forking from {} (step {}, t = {})", ckpt.string(), fork["step"].get<int>(),
+  fsi::logger("fsi")->info("forking from {} (step {}, t = {})", ckpt.dir.string(), fork["step"].get<int>(),
                            fork["time"].get<double>());
 }
 
