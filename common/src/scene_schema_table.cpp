@@ -63,7 +63,9 @@ std::vector<Key> coupling_keys() {
           .def("-1")
           .values({"1", "-1"}),
       number("relaxation", "beta: F^(k+1) = -beta F* + (1 - beta) F^(k); below 2 with Algorithm 1").req().gt(0).says("(beta) must be > 0"),
-      choice("predictor", {"previous", "linear"}, "force predictor: F_n (the paper) or 2 F_n - F_(n-1)")
+      choice("predictor", {"previous", "linear", "quadratic", "cubic"},
+             "force predictor, extrapolating the last 1-4 accepted forces: F_n (the paper), 2 F_n - F_(n-1), "
+             "3 F_n - 3 F_(n-1) + F_(n-2), or 4 F_n - 6 F_(n-1) + 4 F_(n-2) - F_(n-3)")
           .def("previous"),
       choice("acceleration", {"constant", "aitken", "iqn-ils"},
              "constant beta (the paper), Aitken dynamic relaxation, or interface quasi-Newton (IQN-ILS)")

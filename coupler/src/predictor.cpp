@@ -9,6 +9,8 @@ const std::vector<PredictorScheme>& predictor_schemes() {
   static const std::vector<PredictorScheme> schemes{
       {"previous", "the paper: F_n", 0},
       {"linear", "2 F_n - F_{n-1}", 1},
+      {"quadratic", "3 F_n - 3 F_{n-1} + F_{n-2}", 2},
+      {"cubic", "4 F_n - 6 F_{n-1} + 4 F_{n-2} - F_{n-3}", 3},
   };
   return schemes;
 }

@@ -4,6 +4,8 @@
 // through the last degree + 1 of them (Lagrange; Kratos' and CoCoNuT's predictors):
 //   previous   F_n (the paper)
 //   linear     2 F_n - F_{n-1}
+//   quadratic  3 F_n - 3 F_{n-1} + F_{n-2}
+//   cubic      4 F_n - 6 F_{n-1} + 4 F_{n-2} - F_{n-3}
 // With fewer accepted forces than the degree needs (the first steps, a fork from a run that
 // kept fewer), the highest degree the history allows. A new predictor is one line in the
 // registry (predictor.cpp).
