@@ -342,6 +342,21 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
     measures.push_back({{"name", m.name()}, {"limit", m.limit}, {"strict", m.strict}});
   data["coupling"]["measures"] = measures;
   data["coupling"]["combine"] = settings_.combine_all ? "all" : "any";
+  data["coupling"]["predictor"] = settings_.predictor;
+  if (accelerator_scheme(settings_.acceleration).quasi_newton) {
+    const char* filters[] = {"qr1", "qr2", "qr3"};
+    const char* restarts[] = {"none", "rs-0", "rs-ls", "rs-svd"};
+    data["coupling"]["iqn"] = {{"reuse_steps", settings_.reuse_steps},
+                               {"filter", settings_.iqn_filter},
+                               {"filter_type", filters[static_cast<int>(settings_.iqn_filter_type)]},
+                               {"preconditioner", settings_.iqn_preconditioner == Preconditioner::None ? "none"
+                                                                                                      : "residual-sum"}};
+    if (settings_.acceleration == "iqn-imvj")
+      data["coupling"]["iqn"]["imvj"] = {{"restart", restarts[static_cast<int>(settings_.imvj_restart)]},
+                                         {"chunk_size", settings_.imvj_chunk_size},
+                                         {"restart_reuse_steps", settings_.imvj_restart_reuse_steps},
+                                         {"truncation", settings_.imvj_truncation}};
+  }
   log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
             to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
             settings_.tolerance, ns, fluid_interface.nodes());

@@ -52,6 +52,44 @@ void read_relaxation(const ConfigSection& s, CouplingSettings& c) {
                          "is below 2)");
 }
 
+// coupling.iqn.imvj: IQN-IMVJ's restart.
+void read_imvj(const ConfigSection& imvj, CouplingSettings& c) {
+  const auto restart = imvj.get<std::string>("restart", "none");
+  if (restart == "none") c.imvj_restart = ImvjRestart::None;
+  else if (restart == "rs-0") c.imvj_restart = ImvjRestart::Zero;
+  else if (restart == "rs-ls") c.imvj_restart = ImvjRestart::LeastSquares;
+  else if (restart == "rs-svd") c.imvj_restart = ImvjRestart::Svd;
+  else imvj.fail("restart", "must be 'none' (the Jacobian carried over), 'rs-0', 'rs-ls' or 'rs-svd'");
+  c.imvj_chunk_size = imvj.get<int>("chunk_size", 8);
+  if (c.imvj_chunk_size < 1) imvj.fail("chunk_size", "must be >= 1");
+  c.imvj_restart_reuse_steps = imvj.get<int>("restart_reuse_steps", 8);
+  if (c.imvj_restart_reuse_steps < 1) imvj.fail("restart_reuse_steps", "must be >= 1");
+  c.imvj_truncation = imvj.get<double>("truncation", 1e-4);
+  if (!(c.imvj_truncation >= 0 && c.imvj_truncation < 1)) imvj.fail("truncation", "must be in [0, 1)");
+}
+
+// coupling.iqn: the quasi-Newton options.
+void read_quasi_newton(const ConfigSection& iqn, CouplingSettings& c) {
+  c.reuse_steps = iqn.get<int>("reuse_steps", c.reuse_steps);
+  if (c.reuse_steps < 0) iqn.fail("reuse_steps", "must be >= 0");
+  c.iqn_filter = iqn.get<double>("filter", 1e-3);
+  if (!(c.iqn_filter > 0 && c.iqn_filter < 1)) iqn.fail("filter", "must be in (0, 1)");
+  const auto type = iqn.get<std::string>("filter_type", "qr2");
+  if (type == "qr1") c.iqn_filter_type = QrFilter::Qr1;
+  else if (type == "qr2") c.iqn_filter_type = QrFilter::Qr2;
+  else if (type == "qr3") c.iqn_filter_type = QrFilter::Qr3;
+  else iqn.fail("filter_type", "must be 'qr1', 'qr2' or 'qr3'");
+  const auto pre = iqn.get<std::string>("preconditioner", "none");
+  if (pre == "none") c.iqn_preconditioner = Preconditioner::None;
+  else if (pre == "residual-sum") c.iqn_preconditioner = Preconditioner::ResidualSum;
+  else iqn.fail("preconditioner", "must be 'none' or 'residual-sum'");
+  if (iqn.has("imvj")) {
+    if (c.acceleration != "iqn-imvj")
+      iqn.fail("imvj", "is only read with 'acceleration: iqn-imvj' (it is '" + c.acceleration + "')");
+    read_imvj(iqn.child("imvj"), c);
+  }
+}
+
 // coupling.predictor, coupling.acceleration and its options (coupling.iqn).
 void read_schemes(const ConfigSection& s, CouplingSettings& c) {
   c.predictor = s.get<std::string>("predictor", "previous");
@@ -59,14 +97,13 @@ void read_schemes(const ConfigSection& s, CouplingSettings& c) {
   c.acceleration = s.get<std::string>("acceleration", "constant");
   if (!known(accelerator_schemes(), c.acceleration))
     s.fail("acceleration", "must be " + choices(accelerator_schemes()));
+  c.reuse_steps = accelerator_scheme(c.acceleration).default_reuse_steps;
   if (s.has("iqn")) {
     const auto iqn = s.child("iqn");
     if (!accelerator_scheme(c.acceleration).quasi_newton)
-      s.fail("iqn", "is only read with 'acceleration: iqn-ils' (it is '" + c.acceleration + "')");
-    c.reuse_steps = iqn.get<int>("reuse_steps", 8);
-    if (c.reuse_steps < 0) iqn.fail("reuse_steps", "must be >= 0");
-    c.iqn_filter = iqn.get<double>("filter", 1e-3);
-    if (!(c.iqn_filter > 0 && c.iqn_filter < 1)) iqn.fail("filter", "must be in (0, 1)");
+      s.fail("iqn", "is only read with a quasi-Newton acceleration, 'iqn-ils' or 'iqn-imvj' (it is '" +
+                        c.acceleration + "')");
+    read_quasi_newton(iqn, c);
   }
 }
 

@@ -9,9 +9,10 @@ namespace fsi::coupling {
 
 const std::vector<AcceleratorScheme>& accelerator_schemes() {
   static const std::vector<AcceleratorScheme> schemes{
-      {"constant", "the paper: beta", false, make_constant_relaxation},
-      {"aitken", "dynamic relaxation", false, make_aitken},
-      {"iqn-ils", "interface quasi-Newton", true, make_iqn_ils},
+      {"constant", "the paper: beta", false, 0, make_constant_relaxation},
+      {"aitken", "dynamic relaxation", false, 0, make_aitken},
+      {"iqn-ils", "interface quasi-Newton", true, 8, make_iqn_ils},
+      {"iqn-imvj", "interface quasi-Newton, multi-vector Jacobian", true, 0, make_iqn_imvj},
   };
   return schemes;
 }

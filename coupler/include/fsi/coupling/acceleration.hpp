@@ -8,6 +8,10 @@
 //              (Degroote, Bathe & Vierendeels 2009), optionally reusing the secant pairs of
 //              the last `reuse_steps` time steps. Its first iteration, with no secant pair
 //              yet, is the constant relaxation beta.
+//  - iqn-imvj: interface quasi-Newton with the multi-vector Jacobian (Lindner, Mehl, Scheufele
+//              & Uekermann 2015; preCICE's IQN-IMVJ): the inverse Jacobian of earlier steps
+//              is the prior of this step's least-squares update, without or with restarts.
+// The quasi-Newton schemes' filters (qr1, qr2, qr3) and residual-sum preconditioner: settings.hpp.
 // A new scheme is one file with its class and one line in the registry (its scene keys, if
 // it has any, in common/src/scene_schema_table.cpp).
 // Pure linear algebra: no knowledge of solvers, messages or time.
@@ -54,6 +58,7 @@ class Accelerator {
 struct AcceleratorScheme {
   std::string name, phrase;
   bool quasi_newton = false;
+  int default_reuse_steps = 0;  // coupling.iqn.reuse_steps when not given
   std::function<std::unique_ptr<Accelerator>(const CouplingSettings&)> make;
 };
 // Every scheme, in the order messages list them (acceleration_registry.cpp).
