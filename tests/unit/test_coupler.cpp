@@ -406,3 +406,50 @@ TEST(IqnIls, SettingsOnlyWithIqnIls) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(IqnImvj, CouplerConvergesWithAlgorithms1And2AboveTheConstantRelaxationLimit) {
+  // The added-mass model of the IQN-ILS test (beta = 0.5, Algorithm 1's limit 0.1827; Algorithm
+  // 2 with gamma_N1 = 10: 0.2009): IQN-IMVJ, without and with a restart, takes the coupler to the
+  // monolithic solution; from the second step on the carried Jacobian does it in one or two updates.
+  for (const char* algorithm : {"1", "2"})
+    for (const char* iqn : {"{imvj: {restart: none}}", "{imvj: {restart: rs-svd, chunk_size: 3}, filter_type: qr3}",
+                            "{imvj: {restart: rs-ls, chunk_size: 2}, preconditioner: residual-sum}"}) {
+      const auto run = run_scene({std::string("coupling.algorithm=") + algorithm, "coupling.gamma_n1=10",
+                                  "coupling.relaxation=0.5", "coupling.iterations.max=50",
+                                  "coupling.iterations.tolerance=1e-12", "time.end=0.2", "time.dt=0.01", "solid.mass=1",
+                                  "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1",
+                                  "coupling.acceleration=iqn-imvj", std::string("coupling.iqn=") + iqn});
+      ASSERT_EQ(run.outcome.status, "completed") << algorithm << " " << iqn << ": " << run.outcome.reason;
+      const auto iterations = run.column("coupling.iterations");
+      for (std::size_t n = 1; n < iterations.size(); ++n) EXPECT_LE(iterations[n], 3) << algorithm << " " << iqn;
+      double d = 0, v = 0;
+      const double M = 11, c = 0.5, kk = 4, dt = 0.01;
+      const auto dx = run.column("solid.d_x");
+      for (std::size_t n = 0; n < dx.size(); ++n) {
+        const double dn = (1 + M * (d / (dt * dt) + v / dt) + c * d / dt) / (M / (dt * dt) + c / dt + kk);
+        v = (dn - d) / dt;
+        d = dn;
+        ASSERT_NEAR(dx[n], d, 1e-10) << algorithm << " " << iqn << " step " << n + 1;
+      }
+    }
+}
+
+TEST(IqnImvj, OptionsOnlyWithTheirScheme) {
+  EXPECT_THROW(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={imvj: {restart: rs-ls}}"}),
+               fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.acceleration=iqn-imvj", "coupling.iqn={imvj: {restart: rs-lsq}}"}),
+               fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.acceleration=aitken", "coupling.iqn={filter_type: qr3}"}),
+               fsi::ConfigError);
+  const auto s = run_scene_settings({"coupling.acceleration=iqn-imvj", "coupling.predictor=cubic",
+                                     "coupling.iqn={imvj: {restart: rs-svd, truncation: 0.01}, filter_type: qr1}"});
+  EXPECT_EQ(s.reuse_steps, 0);  // IQN-IMVJ's default: its Jacobian carries the steps over
+  EXPECT_EQ(s.imvj_restart, fsi::coupling::ImvjRestart::Svd);
+  EXPECT_EQ(s.imvj_truncation, 0.01);
+  EXPECT_EQ(s.iqn_filter_type, fsi::coupling::QrFilter::Qr1);
+  EXPECT_EQ(run_scene_settings({"coupling.acceleration=iqn-ils"}).reuse_steps, 8);
+}
+
+}  // namespace
