@@ -38,6 +38,7 @@
 #include "check.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/version.hpp"
+#include "fsi/coupling/checkpoint.hpp"
 
 namespace fs = std::filesystem;
 
@@ -215,21 +216,10 @@ void finalize_summary(const fs::path& out, const fsi::Scene& scene, const std::s
   write_json_atomic(out / "summary.json", j);
 }
 
-// The newest complete checkpoint's manifest (null if none).
+// The newest complete checkpoint's manifest (null if none), as the coupler finds it.
 nlohmann::json newest_checkpoint(const fs::path& out) {
-  const fs::path dir = out / "checkpoints";
-  if (!fs::is_directory(dir)) return nullptr;
-  std::vector<fs::path> folders;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_directory() && e.path().filename().string().rfind("step_", 0) == 0 &&
-        e.path().extension() != ".tmp" && fs::exists(e.path() / "manifest.json"))
-      folders.push_back(e.path());
-  std::sort(folders.rbegin(), folders.rend());
-  for (const auto& f : folders) {
-    auto j = read_json(f / "manifest.json");
-    if (j.is_object()) return j;
-  }
-  return nullptr;
+  const auto c = fsi::coupling::CheckpointStore(out / "checkpoints", 1).newest();
+  return c ? c->manifest : nlohmann::json(nullptr);
 }
 
 struct Server {
@@ -272,73 +262,282 @@ struct RunOptions {
 };
 
 // --from PATH: the checkpoint folder (PATH itself when it holds a manifest.json, else the
-// newest complete one under PATH/checkpoints).
-fs::path fork_checkpoint(const std::string& from) {
+// newest complete one under PATH/checkpoints), checked as the coupler checks it.
+fsi::coupling::CheckpointStore::Loaded fork_checkpoint(const std::string& from) {
   const fs::path p(from);
-  if (fs::exists(p / "manifest.json")) return p;
+  if (fs::exists(p / "manifest.json")) {
+    try {
+      return fsi::coupling::CheckpointStore::read(p);
+    } catch (const std::exception& e) {
+      throw fsi::ConfigError(fmt::format("--from '{}': not a complete checkpoint ({})", from, e.what()));
+    }
+  }
   const fs::path dir = p / "checkpoints";
   if (!fs::is_directory(dir))
     throw fsi::ConfigError(fmt::format("--from '{}': neither a checkpoint (no manifest.json) nor a run folder with "
                                        "checkpoints/ (time.checkpoint_every > 0)",
                                        from));
-  std::vector<fs::path> found;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_directory() && e.path().filename().string().rfind("step_", 0) == 0 && fs::exists(e.path() / "manifest.json"))
-      found.push_back(e.path());
-  if (found.empty()) throw fsi::ConfigError(fmt::format("--from '{}': no complete checkpoint in {}", from, dir.string()));
-  std::sort(found.begin(), found.end());
-  return found.back();
+  std::vector<std::string> skipped;
+  auto found = fsi::coupling::CheckpointStore(dir, 1).newest(&skipped);
+  if (!found)
+    throw fsi::ConfigError(fmt::format("--from '{}': no complete checkpoint in {}{}", from, dir.string(),
+                                       skipped.empty() ? std::string() : " (" + skipped.front() + ")"));
+  return *found;
 }
 
 // Copies the checkpoint into OUT/checkpoints/ and writes OUT/forked_from.json: the coupler
 // then continues from it with the scene as given now (changed keys allowed and listed).
 void prepare_fork(const std::string& from, const fs::path& out) {
-  const fs::path ckpt = fork_checkpoint(from);
-  nlohmann::json manifest;
-  try {
-    std::ifstream in(ckpt / "manifest.json");
-    manifest = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw fsi::ConfigError(fmt::format("--from: {} does not parse ({})", (ckpt / "manifest.json").string(), e.what()));
-  }
+  const auto ckpt = fork_checkpoint(from);
+  const nlohmann::json& manifest = ckpt.manifest;
   fs::create_directories(out / "checkpoints");
-  fs::copy(ckpt, out / "checkpoints" / ckpt.filename(), fs::copy_options::recursive);
-  const nlohmann::json fork = {{"checkpoint", fs::absolute(ckpt).string()},
+  fs::copy(ckpt.dir, out / "checkpoints" / ckpt.dir.filename(), fs::copy_options::recursive);
+  const nlohmann::json fork = {{"checkpoint", fs::absolute(ckpt.dir).string()},
                                {"step", manifest.value("step", 0)},
                                {"time", manifest.value("time", 0.0)},
                                {"iterations", manifest.value("iterations", 0)},
                                {"scene_file", manifest.value("scene_file", std::string())},
                                {"overrides", manifest.value("overrides", nlohmann::json::array())}};
   std::ofstream(out / "forked_from.json") << fork.dump(2) << "\n";
-  fsi::logger("fsi")->info("forking from {} (step {}, t = {})", ckpt.string(), fork["step"].get<int>(),
+  fsi::logger("fsi")->info("forking from {} (step {}, t = {})", ckpt.dir.string(), fork["step"].get<int>(),
                            fork["time"].get<double>());
 }
 
-int run(const RunOptions& o) {
+// ---- The run: checked, then one solver alone or the coupled processes with their recovery.
+
+// The launcher's last word on a run: its exit code, and the status and reason it writes into
+// summary.json (empty: the run's own summary stands).
+struct Ending {
+  int code = 1;
+  std::string status, reason;
+};
+
+// A scene that fails `fsi check`: nothing was started; the summary says why, as for every
+// other way a run ends (a run to resume keeps the summary it has).
+int refuse_unchecked(const RunOptions& o, const std::string& problems) {
+  try {
+    if (!o.resume) {
+      const auto scene = fsi::Scene::load(o.scene_path, o.overrides);
+      fsi::prepare_output_dir(o.out_dir, o.force ? fsi::OutputMode::Force : fsi::OutputMode::Fresh);
+      finalize_summary(o.out_dir, scene, "failed", "configuration: " + problems, false);
+    }
+  } catch (const std::exception&) {
+    // An unreadable scene or a refused --out: the problems above are the whole story.
+  }
+  return 1;
+}
+
+// Waits for `child`, forwarding a SIGINT/SIGTERM the launcher receives to it once.
+void wait_forwarding_signals(Child& child, std::chrono::milliseconds poll, bool warn) {
+  bool forwarded = false;
+  while (child.alive()) {
+    reap(child, false);
+    if (g_signal && !forwarded) {
+      if (warn) fsi::logger("fsi")->warn("{} received: stopping the coupler", signal_name(g_signal));
+      kill(child.pid, g_signal);
+      forwarded = true;
+    }
+    std::this_thread::sleep_for(poll);
+  }
+}
+
+// One solver alone (a scene without `coupling`).
+int run_single(const RunOptions& o, const fsi::Scene& scene, const std::vector<std::string>& sets) {
   auto log = fsi::logger("fsi");
+  const bool has_solid = scene.has("solid"), has_fluid = scene.has("fluid");
+  Ending e;
+  Child main;
+  try {
+    if (o.resume) throw fsi::ConfigError("--resume: only coupled runs write checkpoints");
+    if (has_solid == has_fluid)
+      throw fsi::ConfigError(o.scene_path + ": a scene without 'coupling' must have exactly one of 'solid' or 'fluid'");
+    const std::string server = has_solid ? "solid_server" : "fluid_server";
+    std::vector<std::string> argv{(self_dir() / server).string(), "--standalone", o.scene_path, "--out", o.out_dir};
+    argv.insert(argv.end(), sets.begin(), sets.end());
+    log->info("scene '{}': {} alone", o.scene_path, server);
+    main = spawn(server, argv, "");
+    wait_forwarding_signals(main, std::chrono::milliseconds(20), false);
+    e.code = main.status;
+    if (e.code > 128 && e.code != 130) {
+      e.status = "failed";
+      e.reason = fmt::format("{} was killed by {} ({})", server, signal_name(e.code - 128), e.code - 128);
+      e.code = 1;
+    }
+  } catch (const std::exception& ex) {
+    log->error("{}", ex.what());
+    e = {1, "failed", ex.what()};
+  }
+  stop(main, std::chrono::seconds(2));
+  if (g_signal && e.code != 0 && e.code != 2 && e.code != 130 && e.status.empty()) e.code = 130;
+  finalize_summary(o.out_dir, scene, e.status.empty() ? (e.code == 130 ? "interrupted" : "failed") : e.status,
+                   e.reason.empty() ? "the run ended without a final summary" : e.reason, e.status.empty());
+  return e.code;
+}
+
+// The processes of a coupled run: the two servers (solid, fluid) and the coupler.
+struct CoupledProcesses {
+  std::vector<Server> servers;
+  std::vector<Child> children = std::vector<Child>(2);  // solid, fluid
+  Child coupler;
+};
+
+// Starts both servers on free loopback ports.
+void start_servers(const RunOptions& o, const fs::path& ports, CoupledProcesses& p) {
+  auto log = fsi::logger("fsi");
+  fs::create_directories(ports);
+  for (const auto& [side, command] : {std::pair{std::string("solid"), o.solid_command}, {"fluid", o.fluid_command}}) {
+    Server s{side, command, "", ports / (side + ".port"), fs::path(o.out_dir) / (side + "_server.log"), o.curve_keys};
+    const std::size_t i = side == "solid" ? 0 : 1;
+    p.children[i] = start_server(s, self_dir(), "tcp://127.0.0.1:*", kPortFileWait);
+    log->info("{} listening on {} (log: {})", p.children[i].name, s.endpoint, s.log.string());
+    p.servers.push_back(s);
+  }
+}
+
+// The coupler's command line (a later attempt resumes, or restarts when there is nothing to resume).
+std::vector<std::string> coupler_command(const RunOptions& o, const CoupledProcesses& p, bool resume, int attempts,
+                                         int recover, const std::vector<std::string>& sets) {
+  std::vector<std::string> argv{(self_dir() / "coupler").string(), o.scene_path, "--solid", p.servers[0].endpoint,
+                                "--fluid", p.servers[1].endpoint, "--out", o.out_dir, "--timeout",
+                                fmt::format("{}", o.timeout), "--connect-timeout", std::to_string(kHelloWaitSeconds),
+                                "--out-ready"};
+  if (resume) argv.push_back("--resume");
+  if (resume && attempts > 0) argv.push_back("--resume-or-restart");
+  if (recover > 0) argv.push_back("--recoverable");
+  if (!o.curve_keys.empty()) argv.insert(argv.end(), {"--curve-keys", o.curve_keys});
+  argv.insert(argv.end(), sets.begin(), sets.end());
+  return argv;
+}
+
+// A server died or stopped answering (the coupler exited 75): starts it again with the same
+// command and address and records the recovery in summary.json (`lost` = its lost_peer).
+void recover_server(const fs::path& out, CoupledProcesses& p, std::size_t i, nlohmann::json summary,
+                    const nlohmann::json& lost, int attempt, int recover) {
+  auto log = fsi::logger("fsi");
+  const std::string process = lost.value("process", std::string());
+  const auto t0 = std::chrono::steady_clock::now();
+  log->warn("{} {} at step {}: restarting it (recovery {} of {})", process, lost.value("cause", std::string("failed")),
+            lost.value("step", 0), attempt, recover);
+  reap(p.children[i], false);
+  if (p.children[i].alive()) {  // stopped or hung: it cannot be trusted any more
+    kill(-p.children[i].pid, SIGKILL);
+    kill(p.children[i].pid, SIGKILL);
+    reap(p.children[i], true);
+  }
+  p.children[i] = start_server(p.servers[i], self_dir(), p.servers[i].endpoint, kPortFileWait);
+  const nlohmann::json checkpoint = newest_checkpoint(out);
+  const int from = checkpoint.is_object() ? checkpoint.value("step", 0) : 0;
+  const double restart_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double recompute = lost.value("wall_seconds", 0.0) -
+                           (checkpoint.is_object() ? checkpoint.value("wall_seconds", 0.0) : 0.0);
+  nlohmann::json j = summary.is_object() ? summary : nlohmann::json::object();
+  auto& recoveries = j["recoveries"];
+  if (!recoveries.is_array()) recoveries = nlohmann::json::array();
+  recoveries.push_back({{"step", lost.value("step", 0)},
+                        {"process", process},
+                        {"cause", lost.value("cause", std::string("unknown"))},
+                        {"resumed_from_step", from},
+                        {"seconds_lost", std::max(0.0, recompute) + restart_seconds}});
+  j.erase("lost_peer");
+  write_json_atomic(out / "summary.json", j);
+  log->info("{} listening again on {}; resuming from step {}", p.children[i].name, p.servers[i].endpoint, from);
+}
+
+// Runs the coupler until it ends; with `recover` > 0, a server that dies or stops answering
+// is started again and the run resumes from the last checkpoint, up to `recover` times.
+Ending run_with_recovery(const RunOptions& o, CoupledProcesses& p, int recover, const std::vector<std::string>& sets) {
+  const fs::path out(o.out_dir);
+  Ending e;
+  int attempts = 0;
+  bool resume = o.resume || !o.from.empty();
+  while (true) {
+    p.coupler = spawn("coupler", coupler_command(o, p, resume, attempts, recover, sets), "");
+    wait_forwarding_signals(p.coupler, std::chrono::milliseconds(10), true);
+    e.code = p.coupler.status;
+    if (e.code != 75) break;
+    // A server died or stopped answering.
+    const auto summary = read_json(out / "summary.json");
+    const auto lost = summary.is_object() ? summary.value("lost_peer", nlohmann::json::object()) : nlohmann::json();
+    const std::string process = lost.value("process", std::string());
+    if (g_signal)
+      return {130, "interrupted", fmt::format("{} received while recovering {}", signal_name(g_signal), process)};
+    if (attempts >= recover)
+      return {1, "failed",
+              fmt::format("{} {} at step {}; gave up after {} recover{}", process,
+                          lost.value("cause", std::string("failed")), lost.value("step", 0), attempts,
+                          attempts == 1 ? "y" : "ies")};
+    ++attempts;
+    recover_server(out, p, process == "solid_server" ? 0 : 1, summary, lost, attempts, recover);
+    resume = true;
+  }
+  return e;
+}
+
+// After the coupler: a coupler killed by a signal stops both servers at once; a server that
+// failed on its own shows its log.
+void after_coupler(CoupledProcesses& p, Ending& e) {
+  auto log = fsi::logger("fsi");
+  if (e.code > 128 && e.code != 130) {
+    // The coupler itself died: say so at once, stop both servers together.
+    e.status = "failed";
+    e.reason = fmt::format("the coupler was killed by {} ({}); `fsi run ... --resume` continues from the last "
+                           "checkpoint",
+                           signal_name(e.code - 128), e.code - 128);
+    log->error("{}", e.reason);
+    stop_all({&p.children[0], &p.children[1]}, std::chrono::milliseconds(0), std::chrono::milliseconds(400));
+    e.code = 1;
+  }
+  for (auto& c : p.children) {
+    reap(c, false);
+    if (c.status > 0 && c.status != 130 && e.status.empty())
+      log->error("{} exited with code {}; its log ({}):\n{}", c.name, c.status, c.log.string(), tail(c.log, 10));
+  }
+}
+
+// Coupled: two servers and the coupler; with --recover, a server that dies or stops
+// answering is started again with the same command and address and the run resumes
+// from the last checkpoint.
+int run_coupled(const RunOptions& o, const fsi::Scene& scene, const std::vector<std::string>& sets) {
+  auto log = fsi::logger("fsi");
+  const fs::path out(o.out_dir), ports = out / ".ports";
+  CoupledProcesses p;
+  Ending e;
+  try {
+    if (!scene.has("solid") || !scene.has("fluid"))
+      throw fsi::ConfigError(o.scene_path + ": a coupled scene needs 'solid' and 'fluid'");
+    const int every = scene.section("time").get<int>("checkpoint_every", 0);
+    const int recover = o.recover < 0 ? (every > 0 ? 3 : 0) : o.recover;
+    if (recover > 0 && every == 0)
+      log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
+    start_servers(o, ports, p);
+    e = run_with_recovery(o, p, recover, sets);
+    after_coupler(p, e);
+  } catch (const std::exception& ex) {
+    log->error("{}", ex.what());
+    e = {g_signal ? 130 : 1, g_signal ? "interrupted" : "failed", ex.what()};
+  }
+  stop_all({&p.coupler, &p.children[0], &p.children[1]},
+           e.code == 0 || e.code == 2 || e.code == 130 ? std::chrono::seconds(3) : std::chrono::seconds(1));
+  fs::remove_all(ports);
+  if (e.status.empty() && e.code != 0 && e.code != 1 && e.code != 2 && e.code != 130)
+    e = {1, "failed", fmt::format("the coupler exited with code {}", e.code)};
+  finalize_summary(out, scene, e.status.empty() ? "failed" : e.status,
+                   e.reason.empty() ? "the coupler ended without a final summary" : e.reason, e.status.empty());
+  return e.code;
+}
+
+int run(const RunOptions& o) {
   // Every key of every section against the scene schema, before anything starts (fsi check);
   // the sections an external solver reads are its own business.
   std::vector<std::string> external;
   if (!o.solid_command.empty()) external.push_back("solid");
   if (!o.fluid_command.empty()) external.push_back("fluid");
   std::string problems;
-  if (!fsi::launcher::check_before_run(o.scene_path, o.overrides, external, problems)) {
-    // Nothing was started; the summary says why, as for every other way a run ends (a run to
-    // resume keeps the summary it has).
-    try {
-      if (!o.resume) {
-        const auto scene = fsi::Scene::load(o.scene_path, o.overrides);
-        fsi::prepare_output_dir(o.out_dir, o.force ? fsi::OutputMode::Force : fsi::OutputMode::Fresh);
-        finalize_summary(o.out_dir, scene, "failed", "configuration: " + problems, false);
-      }
-    } catch (const std::exception&) {
-      // An unreadable scene or a refused --out: the problems above are the whole story.
-    }
-    return 1;
-  }
+  if (!fsi::launcher::check_before_run(o.scene_path, o.overrides, external, problems))
+    return refuse_unchecked(o, problems);
   const auto scene = fsi::Scene::load(o.scene_path, o.overrides);  // fails early on a bad file
-  const bool has_solid = scene.has("solid"), has_fluid = scene.has("fluid"), coupled = scene.has("coupling");
-  const fs::path out(o.out_dir), bin = self_dir();
+  const bool coupled = scene.has("coupling");
+  const fs::path out(o.out_dir);
   fsi::prepare_output_dir(out, o.resume ? fsi::OutputMode::Resume : o.force ? fsi::OutputMode::Force
                                                                            : fsi::OutputMode::Fresh);
   if (!o.from.empty()) {
@@ -347,174 +546,7 @@ int run(const RunOptions& o) {
   }
   std::vector<std::string> sets;
   for (const auto& ov : o.overrides) sets.insert(sets.end(), {"--set", ov});
-
-  int code = 1;
-  std::string final_status, final_reason;  // set when the launcher has the last word
-  if (!coupled) {
-    // One solver alone.
-    Child main;
-    try {
-      if (o.resume) throw fsi::ConfigError("--resume: only coupled runs write checkpoints");
-      if (has_solid == has_fluid)
-        throw fsi::ConfigError(o.scene_path + ": a scene without 'coupling' must have exactly one of 'solid' or 'fluid'");
-      const std::string server = has_solid ? "solid_server" : "fluid_server";
-      std::vector<std::string> argv{(bin / server).string(), "--standalone", o.scene_path, "--out", o.out_dir};
-      argv.insert(argv.end(), sets.begin(), sets.end());
-      log->info("scene '{}': {} alone", o.scene_path, server);
-      main = spawn(server, argv, "");
-      bool forwarded = false;
-      while (main.alive()) {
-        reap(main, false);
-        if (g_signal && !forwarded) kill(main.pid, g_signal), forwarded = true;
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-      code = main.status;
-      if (code > 128 && code != 130) {
-        final_status = "failed";
-        final_reason = fmt::format("{} was killed by {} ({})", server, signal_name(code - 128), code - 128);
-        code = 1;
-      }
-    } catch (const std::exception& e) {
-      log->error("{}", e.what());
-      final_status = "failed";
-      final_reason = e.what();
-      code = 1;
-    }
-    stop(main, std::chrono::seconds(2));
-    if (g_signal && code != 0 && code != 2 && code != 130 && final_status.empty()) code = 130;
-    finalize_summary(out, scene, final_status.empty() ? (code == 130 ? "interrupted" : "failed") : final_status,
-                     final_reason.empty() ? "the run ended without a final summary" : final_reason,
-                     final_status.empty());
-    return code;
-  }
-
-  // Coupled: two servers and the coupler; with --recover, a server that dies or stops
-  // answering is started again with the same command and address and the run resumes
-  // from the last checkpoint.
-  const fs::path ports = out / ".ports";
-  std::vector<Server> servers;
-  std::vector<Child> children(2);  // solid, fluid
-  Child coupler;
-  int recover = o.recover;
-  try {
-    if (!has_solid || !has_fluid) throw fsi::ConfigError(o.scene_path + ": a coupled scene needs 'solid' and 'fluid'");
-    const int every = scene.section("time").get<int>("checkpoint_every", 0);
-    if (recover < 0) recover = every > 0 ? 3 : 0;
-    if (recover > 0 && every == 0)
-      log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
-    fs::create_directories(ports);
-    for (const auto& [side, command] : {std::pair{std::string("solid"), o.solid_command}, {"fluid", o.fluid_command}}) {
-      Server s{side, command, "", ports / (side + ".port"), out / (side + "_server.log"), o.curve_keys};
-      const std::size_t i = side == "solid" ? 0 : 1;
-      children[i] = start_server(s, bin, "tcp://127.0.0.1:*", kPortFileWait);
-      log->info("{} listening on {} (log: {})", children[i].name, s.endpoint, s.log.string());
-      servers.push_back(s);
-    }
-    int attempts = 0;
-    bool resume = o.resume || !o.from.empty();
-    while (true) {
-      std::vector<std::string> argv{(bin / "coupler").string(), o.scene_path, "--solid", servers[0].endpoint, "--fluid",
-                                    servers[1].endpoint, "--out", o.out_dir, "--timeout", fmt::format("{}", o.timeout),
-                                    "--connect-timeout", std::to_string(kHelloWaitSeconds), "--out-ready"};
-      if (resume) argv.push_back("--resume");
-      if (resume && attempts > 0) argv.push_back("--resume-or-restart");
-      if (recover > 0) argv.push_back("--recoverable");
-      if (!o.curve_keys.empty()) argv.insert(argv.end(), {"--curve-keys", o.curve_keys});
-      argv.insert(argv.end(), sets.begin(), sets.end());
-      coupler = spawn("coupler", argv, "");
-      bool forwarded = false;
-      while (coupler.alive()) {
-        reap(coupler, false);
-        if (g_signal && !forwarded) {
-          log->warn("{} received: stopping the coupler", signal_name(g_signal));
-          kill(coupler.pid, g_signal);
-          forwarded = true;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      }
-      code = coupler.status;
-      if (code != 75) break;
-      // A server died or stopped answering.
-      const auto summary = read_json(out / "summary.json");
-      const auto lost = summary.is_object() ? summary.value("lost_peer", nlohmann::json::object()) : nlohmann::json();
-      const std::string process = lost.value("process", std::string());
-      const std::size_t i = process == "solid_server" ? 0 : 1;
-      if (g_signal) {
-        code = 130;
-        final_status = "interrupted";
-        final_reason = fmt::format("{} received while recovering {}", signal_name(g_signal), process);
-        break;
-      }
-      if (attempts >= recover) {
-        code = 1;
-        final_status = "failed";
-        final_reason = fmt::format("{} {} at step {}; gave up after {} recover{}", process,
-                                   lost.value("cause", std::string("failed")), lost.value("step", 0), attempts,
-                                   attempts == 1 ? "y" : "ies");
-        break;
-      }
-      ++attempts;
-      const auto t0 = std::chrono::steady_clock::now();
-      log->warn("{} {} at step {}: restarting it (recovery {} of {})", process, lost.value("cause", std::string("failed")),
-                lost.value("step", 0), attempts, recover);
-      reap(children[i], false);
-      if (children[i].alive()) {  // stopped or hung: it cannot be trusted any more
-        kill(-children[i].pid, SIGKILL);
-        kill(children[i].pid, SIGKILL);
-        reap(children[i], true);
-      }
-      children[i] = start_server(servers[i], bin, servers[i].endpoint, kPortFileWait);
-      const nlohmann::json checkpoint = newest_checkpoint(out);
-      const int from = checkpoint.is_object() ? checkpoint.value("step", 0) : 0;
-      const double restart_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const double recompute = lost.value("wall_seconds", 0.0) -
-                               (checkpoint.is_object() ? checkpoint.value("wall_seconds", 0.0) : 0.0);
-      nlohmann::json j = summary.is_object() ? summary : nlohmann::json::object();
-      auto& recoveries = j["recoveries"];
-      if (!recoveries.is_array()) recoveries = nlohmann::json::array();
-      recoveries.push_back({{"step", lost.value("step", 0)},
-                            {"process", process},
-                            {"cause", lost.value("cause", std::string("unknown"))},
-                            {"resumed_from_step", from},
-                            {"seconds_lost", std::max(0.0, recompute) + restart_seconds}});
-      j.erase("lost_peer");
-      write_json_atomic(out / "summary.json", j);
-      log->info("{} listening again on {}; resuming from step {}", children[i].name, servers[i].endpoint, from);
-      resume = true;
-    }
-    if (code > 128 && code != 130) {
-      // The coupler itself died: say so at once, stop both servers together.
-      final_status = "failed";
-      final_reason = fmt::format("the coupler was killed by {} ({}); `fsi run ... --resume` continues from the last "
-                                 "checkpoint",
-                                 signal_name(code - 128), code - 128);
-      log->error("{}", final_reason);
-      stop_all({&children[0], &children[1]}, std::chrono::milliseconds(0), std::chrono::milliseconds(400));
-      code = 1;
-    }
-    for (auto& c : children) {
-      reap(c, false);
-      if (c.status > 0 && c.status != 130 && final_status.empty())
-        log->error("{} exited with code {}; its log ({}):\n{}", c.name, c.status, c.log.string(), tail(c.log, 10));
-    }
-  } catch (const std::exception& e) {
-    log->error("{}", e.what());
-    final_status = g_signal ? "interrupted" : "failed";
-    final_reason = e.what();
-    code = g_signal ? 130 : 1;
-  }
-  stop_all({&coupler, &children[0], &children[1]},
-           code == 0 || code == 2 || code == 130 ? std::chrono::seconds(3) : std::chrono::seconds(1));
-  fs::remove_all(ports);
-  if (final_status.empty() && code != 0 && code != 1 && code != 2 && code != 130) {
-    final_status = "failed";
-    final_reason = fmt::format("the coupler exited with code {}", code);
-    code = 1;
-  }
-  finalize_summary(out, scene, final_status.empty() ? "failed" : final_status,
-                   final_reason.empty() ? "the coupler ended without a final summary" : final_reason,
-                   final_status.empty());
-  return code;
+  return coupled ? run_coupled(o, scene, sets) : run_single(o, scene, sets);
 }
 
 // The Python interpreter of the project's Python tools: $FSI_PYTHON, else the one CMake found
@@ -557,14 +589,10 @@ int study(const std::vector<std::string>& study_args) {
   return 1;
 }
 
-}  // namespace
+// ---- The command line: fsi run | keys | check | study.
 
-int main(int argc, char** argv) {
-  CLI::App app{"fsi: partitioned fluid-structure interaction co-simulation"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", fsi::version_line("fsi"));
+CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
   auto* run_cmd = app.add_subcommand("run", "run one scene, starting only the processes it needs");
-  RunOptions o;
   run_cmd->add_option("scene", o.scene_path, "scene file (configs/*.yaml)")->required()->check(CLI::ExistingFile);
   run_cmd->add_option("--out", o.out_dir,
                       "output folder (summary.json, probes.csv, iterations.csv, logs, vtk/, checkpoints/); "
@@ -590,32 +618,55 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--curve-keys", o.curve_keys,
                       "encrypt and authenticate the connections with ZeroMQ CURVE, keys from `fsi keys DIR`")
       ->check(CLI::ExistingDirectory);
-  auto* keys_cmd = app.add_subcommand(
-      "keys", "write a new CURVE key folder for servers and coupler that talk beyond loopback (proto/README.md)");
-  std::string keys_dir;
-  keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")
-      ->required();
+  return run_cmd;
+}
+
+struct CheckOptions {
+  std::string file;
+  std::vector<std::string> overrides;
+  bool reference = false;
+};
+
+CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
   auto* check_cmd = app.add_subcommand(
       "check", "check a scene (or a study's scene with its fixed and varied keys) against the scene schema, "
                "without meshing or starting a solver: fsi check SCENE|STUDY [--set key=value ...]");
-  std::string check_file;
-  std::vector<std::string> check_overrides;
-  bool check_reference = false;
-  check_cmd->add_option("file", check_file, "scene (configs/*.yaml) or study (studies/*.yaml)");
-  check_cmd->add_option("--set", check_overrides, "override any scene key: dotted.key=value (repeatable)");
-  check_cmd->add_flag("--reference", check_reference,
+  check_cmd->add_option("file", c.file, "scene (configs/*.yaml) or study (studies/*.yaml)");
+  check_cmd->add_option("--set", c.overrides, "override any scene key: dotted.key=value (repeatable)");
+  check_cmd->add_flag("--reference", c.reference,
                       "print the scene reference (Markdown, docs/scene-reference.md) from the schema");
-  auto* study_cmd = app.add_subcommand(
-      "study", "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
-               "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
-  study_cmd->allow_extras();
-  study_cmd->prefix_command();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 1;  // command-line errors exit 1, like every failed run
+  return check_cmd;
+}
+
+int check(const CheckOptions& c) {
+  if (c.reference) {
+    std::cout << fsi::schema::reference_markdown();
+    return 0;
   }
-  if (run_cmd->parsed() && o.out_dir.empty()) {
+  if (c.file.empty()) {
+    std::cerr << "fsi check: give a scene or study file (or --reference)\n";
+    return 1;
+  }
+  return fsi::launcher::check_file(c.file, c.overrides);
+}
+
+// `fsi keys DIR`: the coupler writes the key folder. Replaces this process; returns only on failure.
+int keys(std::string keys_dir) {
+  if (fs::exists(fs::path(keys_dir) / "server.key_secret") || fs::exists(fs::path(keys_dir) / "coupler.key_secret")) {
+    fsi::logger("fsi")->error("{} already holds keys: remove them first or choose another folder", keys_dir);
+    return 1;
+  }
+  const std::string coupler = (self_dir() / "coupler").string();
+  std::vector<char*> args{const_cast<char*>(coupler.c_str()), const_cast<char*>("--generate-keys"), keys_dir.data(),
+                          nullptr};
+  execv(args[0], args.data());
+  fsi::logger("fsi")->error("cannot start {}: {}", coupler, std::strerror(errno));
+  return 1;
+}
+
+// The run options that exclude each other, and the default --out: -1 when fine, else the exit code.
+int settle_run_options(RunOptions& o, bool run_parsed) {
+  if (run_parsed && o.out_dir.empty()) {
     o.out_dir = (fs::path("runs") / fs::path(o.scene_path).stem()).string();
     fsi::logger("fsi")->info("results in {} (choose the folder with --out)", o.out_dir);
   }
@@ -627,30 +678,38 @@ int main(int argc, char** argv) {
     fsi::logger("fsi")->error("--resume and --force exclude each other");
     return 1;
   }
+  return -1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fsi: partitioned fluid-structure interaction co-simulation"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", fsi::version_line("fsi"));
+  RunOptions o;
+  auto* run_cmd = add_run_command(app, o);
+  auto* keys_cmd = app.add_subcommand(
+      "keys", "write a new CURVE key folder for servers and coupler that talk beyond loopback (proto/README.md)");
+  std::string keys_dir;
+  keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")
+      ->required();
+  CheckOptions check_options;
+  auto* check_cmd = add_check_command(app, check_options);
+  auto* study_cmd = app.add_subcommand(
+      "study", "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
+               "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
+  study_cmd->allow_extras();
+  study_cmd->prefix_command();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;  // command-line errors exit 1, like every failed run
+  }
+  if (const int code = settle_run_options(o, run_cmd->parsed()); code >= 0) return code;
   if (study_cmd->parsed()) return study(study_cmd->remaining());
-  if (check_cmd->parsed()) {
-    if (check_reference) {
-      std::cout << fsi::schema::reference_markdown();
-      return 0;
-    }
-    if (check_file.empty()) {
-      std::cerr << "fsi check: give a scene or study file (or --reference)\n";
-      return 1;
-    }
-    return fsi::launcher::check_file(check_file, check_overrides);
-  }
-  if (keys_cmd->parsed()) {
-    if (fs::exists(fs::path(keys_dir) / "server.key_secret") || fs::exists(fs::path(keys_dir) / "coupler.key_secret")) {
-      fsi::logger("fsi")->error("{} already holds keys: remove them first or choose another folder", keys_dir);
-      return 1;
-    }
-    const std::string coupler = (self_dir() / "coupler").string();
-    std::vector<char*> args{const_cast<char*>(coupler.c_str()), const_cast<char*>("--generate-keys"),
-                            keys_dir.data(), nullptr};
-    execv(args[0], args.data());
-    fsi::logger("fsi")->error("cannot start {}: {}", coupler, std::strerror(errno));
-    return 1;
-  }
+  if (check_cmd->parsed()) return check(check_options);
+  if (keys_cmd->parsed()) return keys(keys_dir);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {

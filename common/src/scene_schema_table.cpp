@@ -68,20 +68,53 @@ std::vector<Key> coupling_keys() {
           .def("-1")
           .values({"1", "-1"}),
       number("relaxation", "beta: F^(k+1) = -beta F* + (1 - beta) F^(k); below 2 with Algorithm 1").req().gt(0).says("(beta) must be > 0"),
-      choice("predictor", {"previous", "linear"}, "force predictor: F_n (the paper) or 2 F_n - F_(n-1)")
+      choice("predictor", {"previous", "linear", "quadratic", "cubic"},
+             "force predictor, extrapolating the last 1-4 accepted forces: F_n (the paper), 2 F_n - F_(n-1), "
+             "3 F_n - 3 F_(n-1) + F_(n-2), or 4 F_n - 6 F_(n-1) + 4 F_(n-2) - F_(n-3)")
           .def("previous"),
-      choice("acceleration", {"constant", "aitken", "iqn-ils"},
-             "constant beta (the paper), Aitken dynamic relaxation, or interface quasi-Newton (IQN-ILS)")
+      choice("acceleration", {"constant", "aitken", "iqn-ils", "iqn-imvj"},
+             "constant beta (the paper), Aitken dynamic relaxation, or interface quasi-Newton: IQN-ILS (least "
+             "squares) or IQN-IMVJ (multi-vector Jacobian carried over the steps)")
           .def("constant"),
-      section("iqn", "IQN-ILS options",
+      section("iqn", "interface quasi-Newton options (IQN-ILS, IQN-IMVJ; preCICE's semantics)",
               {
-                  integer("reuse_steps", "secant pairs are kept from the last N steps").def("8").ge(0),
-                  number("filter", "drop a column whose orthogonal remainder is below filter x its norm")
-                      .def("0.001")
-                      .gt(0)
-                      .lt(1),
+                  integer("reuse_steps", "secant pairs are kept from the last N steps (IQN-IMVJ carries them in "
+                                         "its Jacobian instead)")
+                      .def("8 (iqn-ils), 0 (iqn-imvj)")
+                      .ge(0),
+                  number("filter", "the filter's limit eps").def("0.001").gt(0).lt(1),
+                  choice("filter_type", {"qr1", "qr2", "qr3"},
+                         "qr1: drop columns with |R_ii| < eps ||R||_F (a limit orders below qr2's, e.g. 1e-8, as the "
+                         "largest columns dominate ||R||_F); qr2: newest first, drop a column whose "
+                         "orthogonal remainder is below eps x its norm; qr3: qr2's result, updating the last "
+                         "iteration's QR and running qr2 only when a column fails")
+                      .def("qr2"),
+                  choice("preconditioner", {"none", "residual-sum"},
+                         "residual-sum: each force component (x, y) weighted by the inverse of the sum of its "
+                         "shares of the residual norm over the step's iterations (updated on a factor 10)")
+                      .def("none"),
+                  section("imvj", "IQN-IMVJ's restart",
+                          {
+                              choice("restart", {"none", "rs-0", "rs-ls", "rs-svd"},
+                                     "none: the dense Jacobian carried over; after chunk_size steps restart "
+                                     "from zero, from the least-squares Jacobian of the last steps, or from a "
+                                     "truncated SVD of the accumulated Jacobian")
+                                  .def("none"),
+                              integer("chunk_size", "steps between restarts").def("8").ge(1).in_unit("steps"),
+                              integer("restart_reuse_steps", "rs-ls: the steps whose secant pairs define the "
+                                                             "restart Jacobian")
+                                  .def("8")
+                                  .ge(1)
+                                  .in_unit("steps"),
+                              number("truncation", "rs-svd: singular values below this share of the largest "
+                                                   "are dropped")
+                                  .def("0.0001")
+                                  .ge(0)
+                                  .lt(1),
+                          })
+                      .only_when("coupling.acceleration", {"iqn-imvj"}, "constant"),
               })
-          .only_when("acceleration", {"iqn-ils"}, "constant"),
+          .only_when("acceleration", {"iqn-ils", "iqn-imvj"}, "constant"),
       section("iterations", "coupling iterations per time step",
               {
                   integer("max", "k_max, coupling iterations per step").req().ge(1),

@@ -125,29 +125,34 @@ CheckpointStore::Written CheckpointStore::write(int step, double time, nlohmann:
   return written;
 }
 
+CheckpointStore::Loaded CheckpointStore::read(const fs::path& dir) {
+  const fs::path manifest_path = dir / "manifest.json";
+  if (!fs::exists(manifest_path)) throw std::runtime_error("no manifest.json (incomplete)");
+  Loaded c;
+  c.manifest = nlohmann::json::parse(read_file(manifest_path));
+  const int version = c.manifest.at("format_version").get<int>();
+  if (version != kFormatVersion)
+    throw std::runtime_error(fmt::format("format version {}, this build reads {}", version, kFormatVersion));
+  c.step = c.manifest.at("step").get<int>();
+  c.time = c.manifest.at("time").get<double>();
+  for (const auto& [name, part] : c.manifest.at("parts").items()) {
+    const std::string bytes = read_file(dir / part.at("file").get<std::string>());
+    if (bytes.size() != part.at("bytes").get<std::size_t>())
+      throw std::runtime_error(fmt::format("part '{}' has {} bytes, the manifest says {}", name, bytes.size(),
+                                           part.at("bytes").get<std::size_t>()));
+    if (crc32_hex(bytes) != part.at("crc32").get<std::string>())
+      throw std::runtime_error(fmt::format("part '{}' fails its checksum", name));
+    c.parts[name] = bytes;
+  }
+  c.dir = dir;
+  return c;
+}
+
 std::optional<CheckpointStore::Loaded> CheckpointStore::newest(std::vector<std::string>* skipped) const {
   for (const auto& [step, dir] : complete_folders(dir_)) {
     try {
-      const fs::path manifest_path = dir / "manifest.json";
-      if (!fs::exists(manifest_path)) throw std::runtime_error("no manifest.json (incomplete)");
-      Loaded c;
-      c.manifest = nlohmann::json::parse(read_file(manifest_path));
-      const int version = c.manifest.at("format_version").get<int>();
-      if (version != kFormatVersion)
-        throw std::runtime_error(fmt::format("format version {}, this build reads {}", version, kFormatVersion));
-      c.step = c.manifest.at("step").get<int>();
-      c.time = c.manifest.at("time").get<double>();
+      Loaded c = read(dir);
       if (c.step != step) throw std::runtime_error(fmt::format("manifest says step {}", c.step));
-      for (const auto& [name, part] : c.manifest.at("parts").items()) {
-        const std::string bytes = read_file(dir / part.at("file").get<std::string>());
-        if (bytes.size() != part.at("bytes").get<std::size_t>())
-          throw std::runtime_error(fmt::format("part '{}' has {} bytes, the manifest says {}", name, bytes.size(),
-                                               part.at("bytes").get<std::size_t>()));
-        if (crc32_hex(bytes) != part.at("crc32").get<std::string>())
-          throw std::runtime_error(fmt::format("part '{}' fails its checksum", name));
-        c.parts[name] = bytes;
-      }
-      c.dir = dir;
       return c;
     } catch (const std::exception& e) {
       if (skipped) skipped->push_back(fmt::format("{}: {}", dir.string(), e.what()));

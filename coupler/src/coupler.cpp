@@ -14,6 +14,7 @@
 #include "fsi/common/state.hpp"
 #include "fsi/coupling/acceleration.hpp"
 #include "fsi/coupling/checkpoint.hpp"
+#include "fsi/coupling/predictor.hpp"
 
 #include <optional>
 #include <tuple>
@@ -90,7 +91,21 @@ NodalMatrix Coupler::physical_mass(const Eigen::VectorXd& solid_displacement, co
 // What carries from one accepted step to the next, and what a checkpoint saves of the
 // coupler (with the accelerator's reused secant pairs and the iteration count).
 struct Coupler::State {
-  Eigen::VectorXd force_n, force_nm1;  // F_n and F_{n-1} (the predictor)
+  // The accepted forces for the predictor: F_n, F_{n-1}, F_{n-2}, F_{n-3}, of which the first
+  // `forces_known` are (F_0 = -F* of the initial state; the others copies of the oldest).
+  Eigen::VectorXd force_n, force_nm1, force_nm2, force_nm3;
+  int forces_known = 1;
+  std::vector<Eigen::VectorXd> force_history() const {
+    const std::vector<Eigen::VectorXd> all{force_n, force_nm1, force_nm2, force_nm3};
+    return std::vector<Eigen::VectorXd>(all.begin(), all.begin() + std::clamp(forces_known, 1, 4));
+  }
+  void accept_force(const Eigen::VectorXd& f) {
+    force_nm3 = force_nm2;
+    force_nm2 = force_nm1;
+    force_nm1 = force_n;
+    force_n = f;
+    forces_known = std::min(forces_known + 1, 4);
+  }
   // The accepted interface state: the solid's displacement and velocity (the velocity
   // measure's k = 1 reference), the fluid's displacement.
   Eigen::VectorXd d_s_prev, v_s_prev, d_f_prev;
@@ -150,7 +165,7 @@ struct Coupler::Run {
         vtk_dir(c.out_dir_ / "vtk"),
         checkpoints(time.checkpoint_every > 0),
         start(start_time),
-        accelerator(c.settings_),
+        accelerator(make_accelerator(c.settings_)),
         parameters(scene_to_json(c.scene_)),
         store(c.out_dir_ / "checkpoints", time.checkpoint_keep) {
     // Output: both solvers' VTK and the coupling interfaces, every time.output_every steps
@@ -176,7 +191,7 @@ struct Coupler::Run {
   const bool checkpoints;
   const double start;  // wall clock at run()'s start
   State state;
-  InterfaceAccelerator accelerator;
+  std::unique_ptr<Accelerator> accelerator;
   bool warned_no_fluid_mass = false;
   // Output; a side that answers three requests without writing a file is named once (its
   // section turns output off, or it cannot write any).
@@ -257,9 +272,10 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
         key != "fluid")
       throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
                                     "coupling, solid, fluid)", scene_.root().where(key), key));
-  if (settings_.predictor == Predictor::Linear)
-    log->warn("predictor 'linear' (2 F_n - F_(n-1)) can excite interface modes the iterations leave "
-              "unconverged (docs/fsi.md); 'previous' is the paper's and the robust choice");
+  if (settings_.predictor != "previous")
+    log->warn("predictor '{}' ({}) can excite interface modes the iterations leave unconverged (docs/fsi.md); "
+              "'previous' is the paper's and the robust choice",
+              settings_.predictor, predictor_scheme(settings_.predictor).phrase);
   const double gamma = settings_.nitsche_penalty;
   const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
   if (implicit && gamma > 0 && !solid_.supports_interface_damping())
@@ -327,13 +343,28 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
                       {"fluid_penalty", settings_.fluid_penalty},
                       {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
                       {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
-                      {"acceleration", to_string(settings_.acceleration)},
+                      {"acceleration", settings_.acceleration},
                       {"robin_mass", to_string(settings_.robin_mass)}};
   nlohmann::json measures = nlohmann::json::array();
   for (const auto& m : settings_.measures)
     measures.push_back({{"name", m.name()}, {"limit", m.limit}, {"strict", m.strict}});
   data["coupling"]["measures"] = measures;
   data["coupling"]["combine"] = settings_.combine_all ? "all" : "any";
+  data["coupling"]["predictor"] = settings_.predictor;
+  if (accelerator_scheme(settings_.acceleration).quasi_newton) {
+    const char* filters[] = {"qr1", "qr2", "qr3"};
+    const char* restarts[] = {"none", "rs-0", "rs-ls", "rs-svd"};
+    data["coupling"]["iqn"] = {{"reuse_steps", settings_.reuse_steps},
+                               {"filter", settings_.iqn_filter},
+                               {"filter_type", filters[static_cast<int>(settings_.iqn_filter_type)]},
+                               {"preconditioner", settings_.iqn_preconditioner == Preconditioner::None ? "none"
+                                                                                                      : "residual-sum"}};
+    if (settings_.acceleration == "iqn-imvj")
+      data["coupling"]["iqn"]["imvj"] = {{"restart", restarts[static_cast<int>(settings_.imvj_restart)]},
+                                         {"chunk_size", settings_.imvj_chunk_size},
+                                         {"restart_reuse_steps", settings_.imvj_restart_reuse_steps},
+                                         {"truncation", settings_.imvj_truncation}};
+  }
   log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
             to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
             settings_.tolerance, ns, fluid_interface.nodes());
@@ -471,6 +502,10 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   const std::string dir = r.restart->dir.string();
   st.force_n = c.vector("force_n", 2 * ns);
   st.force_nm1 = c.vector("force_nm1", 2 * ns);
+  // Before the predictors' longer history: F_n and F_{n-1}.
+  st.force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", 2 * ns) : st.force_nm1;
+  st.force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", 2 * ns) : st.force_nm2;
+  st.forces_known = c.has("forces_known") ? static_cast<int>(c.integer("forces_known")) : 2;
   st.d_s_prev = c.vector("d_s_prev", 2 * ns);
   st.d_f_prev = c.vector("d_f_prev", st.d_f_prev.size());
   if (c.has("v_s_prev")) st.v_s_prev = c.vector("v_s_prev", 2 * ns);
@@ -498,7 +533,7 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   st.work_fluid = c.real("work_fluid");
   st.work_fluid_on_solid = c.real("work_fluid_on_solid");
   r.out.iterations = static_cast<long>(c.integer("iterations"));
-  r.accelerator.load(c, "accelerator.");
+  r.accelerator->load(c, "accelerator.");
 }
 
 void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
@@ -522,13 +557,13 @@ void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
     r.log->warn("checkpoint {} holds no interface velocity (an earlier version): the first step's predictor "
                 "keeps the old algorithm's force", r.restart->dir.string());
   else {
-    for (Eigen::VectorXd* f : {&st.force_n, &st.force_nm1}) {
+    for (Eigen::VectorXd* f : {&st.force_n, &st.force_nm1, &st.force_nm2, &st.force_nm3}) {
       if (old_algorithm == 2 && old_gamma > 0) *f -= old_gamma * apply_nodal(c_mass, st.v_s_prev);
       if (r.implicit && gamma > 0) *f += gamma * apply_nodal(c_mass, st.v_s_prev);
     }
     r.data["forked_from"]["predictor_converted"] = true;
   }
-  r.accelerator = InterfaceAccelerator(settings_);
+  r.accelerator = make_accelerator(settings_);
   r.log->info("forked from algorithm {} (gamma_N1 {}) into algorithm {} (gamma_N1 {}): the force predictor "
               "converted, the reused secant pairs dropped",
               old_algorithm, old_gamma, static_cast<int>(settings_.algorithm), gamma);
@@ -546,7 +581,7 @@ void Coupler::initial_state(Run& r) {
   st.mapped_mass = map_mass(r, loads);
   st.force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s,
                             st.mapped_mass);
-  st.force_nm1 = st.force_n;
+  st.force_nm1 = st.force_nm2 = st.force_nm3 = st.force_n;
   if (r.time.output_every > 0) {  // the initial state, t = 0
     write_output(r, StepInfo{0.0, r.time.dt, 0, 0},
                  InterfaceFields{d_s, v_s, st.force_n, map_.to_solid(loads.traction_force),
@@ -585,13 +620,12 @@ Coupler::Step Coupler::begin_step(Run& r, int n) {
   step.n = n;
   step.t_np1 = n * r.time.dt;
   const State& st = r.state;
-  step.force = settings_.predictor == Predictor::Linear && n > 1 ? Eigen::VectorXd(2 * st.force_n - st.force_nm1)
-                                                                 : st.force_n;
+  step.force = predict_force(predictor_scheme(settings_.predictor), st.force_history());
   const std::size_t n_measures = settings_.measures.size();
   step.converged = n_measures == 0;
   step.first_r.assign(n_measures, 0.0);
   step.values.assign(n_measures, 0.0);
-  r.accelerator.begin_step();
+  r.accelerator->begin_step();
   step.d_iter_prev = st.d_s_prev;
   step.v_iter_prev = st.v_s_prev;
   return step;
@@ -646,7 +680,7 @@ Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
     if (it.damping.rows() > 0) traction_change -= gamma * apply_nodal(it.damping, s.interface_velocity);
     // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
     // (acceleration.hpp for Aitken and IQN-ILS).
-    u.relaxed = r.accelerator.update(step.force, -f_star - step.force);
+    u.relaxed = r.accelerator->update(step.force, -f_star - step.force);
     r.state.mapped_mass = it.mass;  // the next solid solve's damping (Algorithm 2)
   }
   if (!all_finite(u.relaxed))
@@ -772,9 +806,8 @@ void Coupler::accept_step(Run& r, Step& step) {
                                               map_.to_solid(last.loads.velocity_integral), last.d_f,
                                               map_.to_fluid(last.s.interface_velocity), last.loads.traction_force,
                                               last.loads.velocity_integral});
-  r.accelerator.end_step();
-  r.state.force_nm1 = r.state.force_n;
-  r.state.force_n = step.force;
+  r.accelerator->end_step();
+  r.state.accept_force(step.force);
   r.out.steps = n;
   if (r.checkpoints && n % r.time.checkpoint_every == 0 && n < r.time.steps) {
     save_checkpoint(r, n, t_np1);
@@ -835,6 +868,9 @@ void Coupler::save_checkpoint(Run& r, int n, double t_np1) {
   c.put("step", static_cast<std::int64_t>(n));
   c.put("force_n", st.force_n);
   c.put("force_nm1", st.force_nm1);
+  c.put("force_nm2", st.force_nm2);
+  c.put("force_nm3", st.force_nm3);
+  c.put("forces_known", static_cast<std::int64_t>(st.forces_known));
   c.put("d_s_prev", st.d_s_prev);
   c.put("d_f_prev", st.d_f_prev);
   c.put("work_solid", st.work_solid);
@@ -852,7 +888,7 @@ void Coupler::save_checkpoint(Run& r, int n, double t_np1) {
     c.put("mapped_mass.values", values);
   }
   c.put("iterations", static_cast<std::int64_t>(r.out.iterations));
-  r.accelerator.save(c, "accelerator.");
+  r.accelerator->save(c, "accelerator.");
   parts["coupler"] = c.serialize();
   nlohmann::json manifest = {{"scene", r.data.value("scene", std::string())},
                              {"scene_file", scene_.origin()},

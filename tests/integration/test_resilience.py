@@ -139,6 +139,21 @@ RESUME_CASES = {
                                               "coupling.relaxation=0.5"], 1250, 60),
     "thick_beam": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10"], 27, 240),
     "fsi3_iqn": ("fsi3.yaml", FSI3_COARSE + ["time.end=0.05", "time.checkpoint_every=6"], 9, 400),
+    # IQN-IMVJ's Jacobian (dense without restart; factors, secant pairs and SVD with one), the
+    # qr3 filter's and residual-sum preconditioner's state and the cubic/quadratic predictors'
+    # force history, across the checkpoint.
+    "added_mass_imvj": ("added_mass.yaml", ["time.end=20", "time.checkpoint_every=100", "coupling.acceleration=iqn-imvj",
+                                            "coupling.relaxation=0.5", "coupling.predictor=cubic"], 1250, 60),
+    "added_mass_imvj_svd": ("added_mass.yaml", ["time.end=20", "time.checkpoint_every=100",
+                                                "coupling.acceleration=iqn-imvj", "coupling.relaxation=0.5",
+                                                "coupling.iqn={imvj: {restart: rs-svd, chunk_size: 3}, filter_type: qr3, "
+                                                "preconditioner: residual-sum}"], 1250, 60),
+    "thick_beam_imvj": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10", "coupling.algorithm=2",
+                                            "coupling.acceleration=iqn-imvj", "coupling.predictor=quadratic",
+                                            "coupling.iqn={imvj: {restart: rs-ls, chunk_size: 4, restart_reuse_steps: 2}, "
+                                            "filter_type: qr3, preconditioner: residual-sum}",
+                                            "coupling.iterations={max: 8, tolerance: 1.0e-4, stop_if_not_converged: false}"],
+                        27, 240),
 }
 
 
@@ -175,6 +190,8 @@ def resume_case(env, name, how, extra=()):
 def resume_small(env):
     resume_case(env, "sdof_model", "kill -9 coupler")
     resume_case(env, "added_mass_aitken", "SIGINT")
+    resume_case(env, "added_mass_imvj", "kill -9 coupler")
+    resume_case(env, "added_mass_imvj_svd", "SIGINT")
     # The Python example solid in place of solid_server saves and loads its own state.
     solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
     RESUME_CASES["python_solid"] = RESUME_CASES["sdof_model"]
@@ -183,6 +200,7 @@ def resume_small(env):
 
 def resume_thick_beam(env):
     resume_case(env, "thick_beam", "kill -9 coupler")
+    resume_case(env, "thick_beam_imvj", "SIGINT")
 
 
 def resume_fsi3(env):

@@ -179,7 +179,7 @@ TEST(OutputDir, FreshRefusesForceCleansResumeKeeps) {
 
 TEST(Accelerator, SavedIqnHistoryGivesIdenticalUpdates) {
   fsi::coupling::CouplingSettings s;
-  s.acceleration = fsi::coupling::Acceleration::IqnIls;
+  s.acceleration = "iqn-ils";
   s.relaxation = 0.3;
   s.reuse_steps = 3;
   // A linear interface problem F = G(F) = A F + b that changes slowly with the step.
@@ -189,12 +189,13 @@ TEST(Accelerator, SavedIqnHistoryGivesIdenticalUpdates) {
     Eigen::Vector3d b(1.0, 2.0 + 0.1 * step, -1.0);
     return Eigen::VectorXd(a * x + b - x);
   };
-  auto run_step = [&](fsi::coupling::InterfaceAccelerator& acc, Eigen::VectorXd& x, int step) {
+  auto run_step = [&](fsi::coupling::Accelerator& acc, Eigen::VectorXd& x, int step) {
     acc.begin_step();
     for (int k = 0; k < 6; ++k) x = acc.update(x, residual(x, step));
     acc.end_step();
   };
-  fsi::coupling::InterfaceAccelerator a(s), b(s);
+  auto a_ptr = fsi::coupling::make_accelerator(s), b_ptr = fsi::coupling::make_accelerator(s);
+  auto &a = *a_ptr, &b = *b_ptr;
   Eigen::VectorXd xa = Eigen::VectorXd::Zero(3);
   for (int step = 1; step <= 4; ++step) run_step(a, xa, step);
   StateArchive state;

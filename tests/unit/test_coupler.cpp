@@ -309,7 +309,7 @@ struct LinearProblem {
       for (int j = 0; j < n; ++j) a(i, j) = (i == j ? -1.6 + 0.3 * i : 0.0) + 0.05 * std::sin(1.0 + i + 3.0 * j);
   }
   // Iterations to |r| < 1e-10 |x*| from x = 0, or -1.
-  int solve(fsi::coupling::InterfaceAccelerator& acc, const Eigen::VectorXd& b, Eigen::VectorXd& x, int max = 50) const {
+  int solve(fsi::coupling::Accelerator& acc, const Eigen::VectorXd& b, Eigen::VectorXd& x, int max = 50) const {
     acc.begin_step();
     x = Eigen::VectorXd::Zero(b.size());
     const Eigen::VectorXd exact = (Eigen::MatrixXd::Identity(b.size(), b.size()) - a).lu().solve(b);
@@ -327,12 +327,13 @@ struct LinearProblem {
 
 TEST(IqnIls, SolvesALinearInterfaceProblemInAtMostNPlusOneIterations) {
   fsi::coupling::CouplingSettings s;
-  s.acceleration = fsi::coupling::Acceleration::IqnIls;
+  s.acceleration = "iqn-ils";
   s.relaxation = 0.3;
   const int n = 6;
   LinearProblem p(n);
   ASSERT_GT(p.a.eigenvalues().cwiseAbs().maxCoeff(), 1.0);
-  fsi::coupling::InterfaceAccelerator acc(s);
+  auto acc_ptr = fsi::coupling::make_accelerator(s);
+  auto& acc = *acc_ptr;
   Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, 1.0, 2.0), x;
   const int k = p.solve(acc, b, x);
   EXPECT_GE(k, 2);
@@ -342,26 +343,26 @@ TEST(IqnIls, SolvesALinearInterfaceProblemInAtMostNPlusOneIterations) {
   // Constant relaxation beta = 1 diverges on the same problem.
   fsi::coupling::CouplingSettings plain;
   plain.relaxation = 1.0;
-  fsi::coupling::InterfaceAccelerator constant(plain);
-  EXPECT_EQ(p.solve(constant, b, x), -1);
+  auto constant = fsi::coupling::make_accelerator(plain);
+  EXPECT_EQ(p.solve(*constant, b, x), -1);
 }
 
 TEST(IqnIls, ReusedSecantPairsSolveLaterStepsInOneUpdate) {
   fsi::coupling::CouplingSettings s;
-  s.acceleration = fsi::coupling::Acceleration::IqnIls;
+  s.acceleration = "iqn-ils";
   s.relaxation = 0.3;
   s.reuse_steps = 2;
   const int n = 8;
   LinearProblem p(n);
-  fsi::coupling::InterfaceAccelerator reuse(s);
+  auto reuse = fsi::coupling::make_accelerator(s);
   fsi::coupling::CouplingSettings s0 = s;
   s0.reuse_steps = 0;
-  fsi::coupling::InterfaceAccelerator fresh(s0);
+  auto fresh = fsi::coupling::make_accelerator(s0);
   Eigen::VectorXd x;
   for (int step = 0; step < 4; ++step) {
     const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, 1.0 + step, -1.0 + 0.5 * step);
-    const int with_reuse = p.solve(reuse, b, x);
-    const int without = p.solve(fresh, b, x);
+    const int with_reuse = p.solve(*reuse, b, x);
+    const int without = p.solve(*fresh, b, x);
     EXPECT_GE(without, n / 2) << "step " << step;
     if (step > 0) {
       EXPECT_LE(with_reuse, 2) << "step " << step;  // one exact update, then the check
@@ -402,6 +403,53 @@ TEST(IqnIls, SettingsOnlyWithIqnIls) {
   EXPECT_THROW(run_scene_settings({"coupling.acceleration=aitken", "coupling.iqn={reuse_steps: 4}"}), fsi::ConfigError);
   EXPECT_THROW(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={reuse_step: 4}"}), fsi::ConfigError);
   EXPECT_EQ(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={reuse_steps: 4, filter: 0.01}"}).reuse_steps, 4);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(IqnImvj, CouplerConvergesWithAlgorithms1And2AboveTheConstantRelaxationLimit) {
+  // The added-mass model of the IQN-ILS test (beta = 0.5, Algorithm 1's limit 0.1827; Algorithm
+  // 2 with gamma_N1 = 10: 0.2009): IQN-IMVJ, without and with a restart, takes the coupler to the
+  // monolithic solution; from the second step on the carried Jacobian does it in one or two updates.
+  for (const char* algorithm : {"1", "2"})
+    for (const char* iqn : {"{imvj: {restart: none}}", "{imvj: {restart: rs-svd, chunk_size: 3}, filter_type: qr3}",
+                            "{imvj: {restart: rs-ls, chunk_size: 2}, preconditioner: residual-sum}"}) {
+      const auto run = run_scene({std::string("coupling.algorithm=") + algorithm, "coupling.gamma_n1=10",
+                                  "coupling.relaxation=0.5", "coupling.iterations.max=50",
+                                  "coupling.iterations.tolerance=1e-12", "time.end=0.2", "time.dt=0.01", "solid.mass=1",
+                                  "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1",
+                                  "coupling.acceleration=iqn-imvj", std::string("coupling.iqn=") + iqn});
+      ASSERT_EQ(run.outcome.status, "completed") << algorithm << " " << iqn << ": " << run.outcome.reason;
+      const auto iterations = run.column("coupling.iterations");
+      for (std::size_t n = 1; n < iterations.size(); ++n) EXPECT_LE(iterations[n], 3) << algorithm << " " << iqn;
+      double d = 0, v = 0;
+      const double M = 11, c = 0.5, kk = 4, dt = 0.01;
+      const auto dx = run.column("solid.d_x");
+      for (std::size_t n = 0; n < dx.size(); ++n) {
+        const double dn = (1 + M * (d / (dt * dt) + v / dt) + c * d / dt) / (M / (dt * dt) + c / dt + kk);
+        v = (dn - d) / dt;
+        d = dn;
+        ASSERT_NEAR(dx[n], d, 1e-10) << algorithm << " " << iqn << " step " << n + 1;
+      }
+    }
+}
+
+TEST(IqnImvj, OptionsOnlyWithTheirScheme) {
+  EXPECT_THROW(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={imvj: {restart: rs-ls}}"}),
+               fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.acceleration=iqn-imvj", "coupling.iqn={imvj: {restart: rs-lsq}}"}),
+               fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.acceleration=aitken", "coupling.iqn={filter_type: qr3}"}),
+               fsi::ConfigError);
+  const auto s = run_scene_settings({"coupling.acceleration=iqn-imvj", "coupling.predictor=cubic",
+                                     "coupling.iqn={imvj: {restart: rs-svd, truncation: 0.01}, filter_type: qr1}"});
+  EXPECT_EQ(s.reuse_steps, 0);  // IQN-IMVJ's default: its Jacobian carries the steps over
+  EXPECT_EQ(s.imvj_restart, fsi::coupling::ImvjRestart::Svd);
+  EXPECT_EQ(s.imvj_truncation, 0.01);
+  EXPECT_EQ(s.iqn_filter_type, fsi::coupling::QrFilter::Qr1);
+  EXPECT_EQ(run_scene_settings({"coupling.acceleration=iqn-ils"}).reuse_steps, 8);
 }
 
 }  // namespace

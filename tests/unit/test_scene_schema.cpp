@@ -54,7 +54,7 @@ TEST(SceneSchema, ProblemsNameKeyPlaceAndSuggestion) {
   EXPECT_EQ(problems(kScene, {"fluid.added_mass=-1", "coupling.iqn.filter=0.5"}),
             (std::vector<std::string>{
                 "s.yaml (--set coupling.iqn.filter=0.5): 'coupling.iqn' is only used when 'coupling.acceleration' "
-                "is iqn-ils",
+                "is iqn-ils or iqn-imvj",
                 "s.yaml (--set fluid.added_mass=-1): 'fluid.added_mass' must be >= 0, got '-1'",
             }));
   EXPECT_EQ(problems("time: {dt: 0.1, end: 1.0}\nsolid: {model: sdof, mass: 1}\nfluid: {model: surrogate}\n"),

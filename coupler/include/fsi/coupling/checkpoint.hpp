@@ -43,6 +43,9 @@ class CheckpointStore {
   // The newest complete checkpoint; incomplete or corrupt ones are skipped, each with its
   // reason in `skipped` (if given). nullopt when there is none.
   std::optional<Loaded> newest(std::vector<std::string>* skipped = nullptr) const;
+  // One checkpoint folder, checked as newest() checks each (throws std::runtime_error naming
+  // what is wrong). The launcher reads checkpoints with these two as well.
+  static Loaded read(const std::filesystem::path& dir);
 
   // "step_00000050"
   static std::string folder_name(int step);

@@ -10,11 +10,6 @@
 namespace fsi::coupling {
 
 enum class Algorithm { ExplicitSolidVelocity = 1, ImplicitSolidVelocity = 2 };
-enum class Predictor { Previous, Linear };
-// How F^(k+1) follows from F^(k) and F*: the paper's constant relaxation, Aitken's dynamic
-// relaxation (Kuttler & Wall 2008) or interface quasi-Newton IQN-ILS (Degroote et al. 2009),
-// both beyond the paper and both starting each step with beta (acceleration.hpp).
-enum class Acceleration { Constant, Aitken, IqnIls };
 // The interface mass of the gamma_N1 terms on the solid's side: `consistent` = the fluid's
 // own M_f in the configuration of its last solve, mapped H^T M_f H (the terms cancel exactly
 // at convergence, any meshes, any deformation); `solid` = the solid's polyline int N^T N
@@ -41,6 +36,24 @@ struct ConvergenceMeasure {
   std::string name() const;  // e.g. "traction_relative" (its iterations.csv column)
 };
 
+// The interface quasi-Newton schemes' options (coupling.iqn; preCICE's semantics):
+//   filter of the secant columns (newest first), with limit eps:
+//     qr1  after the QR decomposition, drop columns with |R_ii| < eps ||R||_F (repeatedly)
+//     qr2  orthogonalise newest first, drop a column whose remainder is < eps x its own norm
+//     qr3  qr2's result, found by updating the last iteration's QR with the new column and
+//          running qr2 only when a column fails the test (or the preconditioner changed)
+//   preconditioner: none, or residual-sum (each force component x, y weighted by the inverse
+//     of the sum over the step's iterations of its share of the residual norm; the weights
+//     change only by more than a factor 10).
+enum class QrFilter { Qr1, Qr2, Qr3 };
+enum class Preconditioner { None, ResidualSum };
+// IQN-IMVJ (coupling.iqn.imvj): without restart the inverse Jacobian J_n (dense, n x n)
+// carries over from step to step; a restart mode keeps only the last `chunk_size` steps'
+// updates and then restarts: rs-0 from zero, rs-ls from the least-squares Jacobian of the
+// last `restart_reuse_steps` steps' secant pairs, rs-svd from a truncated SVD of the
+// accumulated update (singular values below `truncation` x the largest are dropped).
+enum class ImvjRestart { None, Zero, LeastSquares, Svd };
+
 struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
   double nitsche_penalty = 0;     // gamma_N1 >= 0
@@ -50,10 +63,21 @@ struct CouplingSettings {
   double fluid_penalty = 0;
   double nitsche_symmetry = -1;   // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
   double relaxation = 1;          // beta in (0, 1]
-  Predictor predictor = Predictor::Previous;  // F^(1)_{n+1} = F_n (the paper)
-  Acceleration acceleration = Acceleration::Constant;
-  int reuse_steps = 8;            // IQN-ILS: secant pairs of the last N accepted steps are reused
-  double iqn_filter = 1e-3;       // IQN-ILS: drop a column whose orthogonal remainder is below this share
+  // F^(1)_{n+1} from the accepted forces: a name of predictor.hpp's registry ("previous" =
+  // F_n, the paper).
+  std::string predictor = "previous";
+  // How F^(k+1) follows from F^(k) and F*: a name of acceleration.hpp's registry ("constant" =
+  // the paper's beta; Aitken and the quasi-Newton schemes are beyond the paper and start each
+  // step with beta).
+  std::string acceleration = "constant";
+  int reuse_steps = 8;            // quasi-Newton: secant pairs of the last N accepted steps are reused
+  double iqn_filter = 1e-3;       // quasi-Newton: the filter's limit eps
+  QrFilter iqn_filter_type = QrFilter::Qr2;
+  Preconditioner iqn_preconditioner = Preconditioner::None;
+  ImvjRestart imvj_restart = ImvjRestart::None;
+  int imvj_chunk_size = 8;            // restart after this many steps
+  int imvj_restart_reuse_steps = 8;   // rs-ls: the steps whose secant pairs define the restart
+  double imvj_truncation = 1e-4;      // rs-svd: relative truncation of the singular values
   int max_iterations = 1;         // k_max
   // 0: exactly max_iterations iterations per step (the paper). > 0: iterate until the
   // relative interface residual ||F^(k+1) - F^(k)|| / ||F^(k+1)|| is below it.
@@ -73,7 +97,6 @@ struct CouplingSettings {
 CouplingSettings read_coupling(const ConfigSection& section);
 
 std::string to_string(Algorithm a);
-std::string to_string(Acceleration a);
 std::string to_string(RobinMass m);
 
 }  // namespace fsi::coupling
