@@ -59,8 +59,13 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
   hs_.setFromTriplets(ts.begin(), ts.end());
   hst_ = hs_.transpose();
 
-  // Conforming? The nearest solid node of every fluid node (detection only: H stays the
-  // projection above, which for coinciding nodes is P to round-off).
+  detect_conforming(solid, fluid);
+}
+
+// Conforming? The nearest solid node of every fluid node (detection only: H stays the
+// projection above, which for coinciding nodes is P to round-off).
+void InterfaceMap::detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
+  const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
   Eigen::Vector2d lo = solid.coordinates.colwise().minCoeff().transpose();
   Eigen::Vector2d hi = solid.coordinates.colwise().maxCoeff().transpose();
   lo = lo.cwiseMin(fluid.coordinates.colwise().minCoeff().transpose());

@@ -123,11 +123,11 @@ std::vector<int> step_updates(CouplingSettings s, int steps, int n = 10) {
 TEST(IqnImvj, WithoutRestartLaterStepsConvergeFasterWithTheJacobianCarriedOver) {
   const auto imvj = step_updates(quasi_newton("iqn-imvj"), 5);
   const auto ils = step_updates(quasi_newton("iqn-ils"), 5);  // no reuse: every step starts afresh
-  ASSERT_GE(imvj[0], 5);
+  ASSERT_GE(imvj[0], 5);  // n + 1 = 11 here
   for (int step = 1; step < 5; ++step) {
     EXPECT_LT(imvj[step], imvj[0]) << "step " << step;
-    EXPECT_LE(imvj[step], 3) << "step " << step;  // J exact after the first step: one update, maybe two
-    EXPECT_GE(ils[step], ils[0] - 1) << "step " << step;
+    EXPECT_LE(imvj[step], 2) << "step " << step;  // J exact after the first step: one update (1 here)
+    EXPECT_GE(ils[step], ils[0] - 1) << "step " << step;  // IQN-ILS without reuse: n + 1 every step
   }
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // How the coupler's interface fixed-point iteration F^(k+1) = G(F^(k)) is updated from the
 // residual r_k = -F*(F^(k)) - F^(k): one class per scheme behind the interface Accelerator,
-// made by make_accelerator() from the scheme's name in the registry (acceleration_registry.cpp):
+// made by make_accelerator() from the scheme's name in the registry (src/acceleration/registry.cpp):
 //  - constant: F^(k+1) = F^(k) + beta r_k (the seed paper);
 //  - aitken:   omega_k from the last two residuals (Kuttler & Wall 2008), starting at beta;
 //  - iqn-ils:  interface quasi-Newton with a least-squares model of the inverse Jacobian
@@ -61,7 +61,7 @@ struct AcceleratorScheme {
   int default_reuse_steps = 0;  // coupling.iqn.reuse_steps when not given
   std::function<std::unique_ptr<Accelerator>(const CouplingSettings&)> make;
 };
-// Every scheme, in the order messages list them (acceleration_registry.cpp).
+// Every scheme, in the order messages list them (src/acceleration/registry.cpp).
 const std::vector<AcceleratorScheme>& accelerator_schemes();
 // The scheme of that name (throws std::invalid_argument for an unknown one).
 const AcceleratorScheme& accelerator_scheme(const std::string& name);

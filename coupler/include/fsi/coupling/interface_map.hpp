@@ -37,6 +37,8 @@ class InterfaceMap {
   double permutation_error() const { return permutation_error_; }
 
  private:
+  // Whether H is a permutation (conforming meshes): coincident_nodes_, conforming_, permutation_error_.
+  void detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid);
   Eigen::SparseMatrix<double> h_, ht_;
   Eigen::SparseMatrix<double> hs_, hst_;  // the scalar (per node) H, n_f x n_s, and its transpose
   double max_gap_ = 0;
