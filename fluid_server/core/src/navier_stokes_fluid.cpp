@@ -14,7 +14,6 @@
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
-#include "fsi/fluid/taylor_hood_solver.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -246,8 +245,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
   }
 
-  if (taylor_hood) solver_ = std::make_unique<TaylorHoodSolver>(mesh, params);
-  else solver_ = std::make_unique<NavierStokesSolver>(mesh, params);
+  solver_ = std::make_unique<FlowSolver>(std::move(mesh), params, element);
   auto& solver = *solver_;
   const auto& fluid_mesh = solver.mesh();
 
@@ -420,9 +418,7 @@ Eigen::MatrixX2d NavierStokesFluid::extend(const Eigen::VectorXd& interface_disp
   const auto& mesh = solver_->mesh();
   Eigen::MatrixX2d out(mesh.node_count(), 2);
   out.topRows(mesh.vertices()) = vertex;
-  for (int e = 0; e < mesh.triangle_count(); ++e)
-    for (int k = 0; k < 3; ++k)
-      out.row(mesh.edge_nodes(e, k)) = 0.5 * (vertex.row(mesh.triangles(e, k)) + vertex.row(mesh.triangles(e, (k + 1) % 3)));
+  mesh.interpolate_midpoints(out);
   const auto& nodes = solver_->interface_nodes();
   for (std::size_t i = 0; i < nodes.size(); ++i)
     out.row(nodes[i]) = interface_displacement.segment<2>(2 * static_cast<Eigen::Index>(i)).transpose();

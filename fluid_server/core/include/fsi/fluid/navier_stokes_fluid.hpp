@@ -1,7 +1,7 @@
 #pragma once
 // fsi::FluidModel for `fluid: {model: fem, ...}`: reads the scene keys (documented in
 // configs/dfg_2d1.yaml and docs/fluid.md), meshes the .geo with the gmsh CLI (cached),
-// runs NavierStokesSolver (fluid.element: p1p1) or TaylorHoodSolver (p2p1), moves the mesh by a harmonic extension of the interface
+// runs FlowSolver with fluid.element p1p1 or p2p1, moves the mesh by a harmonic extension of the interface
 // displacement, and reports drag/lift (consistent reactions), pressure probes, VTK.
 //
 // Call order (fsi::FluidModel): configure -> interface -> {solve_step ... accept_step} -> write_output.
