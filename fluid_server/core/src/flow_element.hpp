@@ -10,7 +10,8 @@
 //   - the output: the pressure at every node, the velocity at a point of a triangle.
 // The two parts, make_p1p1_element (flow_element_p1p1.cpp: P1/P1 SUPG/PSPG/LSIC) and
 // make_p2p1_element (flow_element_p2p1.cpp: isoparametric Taylor-Hood P2/P1), are selected by
-// the scene's fluid.element name.
+// the scene's fluid.element name. (The midpoints of a 6-node mesh follow their vertices, in
+// the P2 nodal pressure and in the vertex-driven mesh motion, by FluidMesh::interpolate_midpoints.)
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -77,7 +78,8 @@ class FlowElement {
   virtual DofLayout layout() const = 0;
   virtual int local_size() const = 0;                         // unknowns per triangle
   virtual void element_dofs(int e, int* dofs) const = 0;      // local_size() global unknowns
-  // Halve a Newton update that grows the change (iterations 3 on)?
+  // Halve a Newton update that grows the change (iterations 3 on)? P2/P1 yes; P1/P1 no (its
+  // Newton, the Galerkin Jacobian with Picard stabilisation terms, has always run undamped).
   virtual bool damped_newton() const = 0;
 
   // --- local assembly ---
