@@ -14,7 +14,6 @@
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
-#include "fsi/fluid/taylor_hood_solver.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -64,6 +63,222 @@ std::string read_text(const std::filesystem::path& path) {
   return ss.str();
 }
 
+// --- fluid.mesh ---
+
+// One place for every run, so a mesh is made once: $FSI_MESH_CACHE, else
+// $XDG_CACHE_HOME/fsi/meshes, else ~/.cache/fsi/meshes (entries keyed by a hash of the .geo
+// text, its parameters and the element order); fluid.mesh.cache_dir overrides it.
+std::filesystem::path mesh_cache(const ConfigSection& mesh_section) {
+  std::filesystem::path cache;
+  if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env) cache = env;
+  else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) cache = std::filesystem::path(xdg) / "fsi" / "meshes";
+  else if (const char* home = std::getenv("HOME"); home && *home) cache = std::filesystem::path(home) / ".cache" / "fsi" / "meshes";
+  else cache = std::filesystem::temp_directory_path() / "fsi_fluid_meshes";
+  if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
+  return cache;
+}
+
+// The .msh file: fluid.mesh.file, or fluid.mesh.geo meshed by gmsh (cached) with the size h,
+// the further parameters and the element order.
+std::filesystem::path mesh_file(const ConfigSection& mesh_section, int order) {
+  if (mesh_section.has("file")) return resolve_path(mesh_section, "file");
+  const auto geo = resolve_path(mesh_section, "geo");
+  std::map<std::string, double> parameters;
+  parameters["h"] = mesh_section.get<double>("size");
+  if (!(parameters["h"] > 0)) mesh_section.fail("size", "must be positive");
+  if (auto extra = mesh_section.optional_child("parameters"))
+    for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
+  return mesh_geo(geo, parameters, mesh_cache(mesh_section), order);
+}
+
+// The mesh of `msh` in the element's order (P2/P1: a linear mesh gets straight midpoints).
+FluidMesh read_mesh(const ConfigSection& mesh_section, const std::filesystem::path& msh, bool taylor_hood) {
+  const auto domain = string_list(mesh_section, "domain");
+  FluidMesh mesh;
+  try {
+    mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
+  } catch (const fsi::ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    if (mesh_section.has("file")) throw;
+    // The user wrote the .geo: name it, not the cache file gmsh wrote from it.
+    mesh_section.fail("geo", fmt::format("gmsh meshed it, but the mesh cannot be used ({}): a .geo needs a plane "
+                                         "surface and the physical groups of fluid.mesh.domain and the boundaries",
+                                         e.what()));
+  }
+  if (taylor_hood && !mesh.quadratic()) {
+    fsi::logger("fluid")->info("fluid: {} has 3-node triangles; the P2/P1 elements get straight edges (mesh with gmsh "
+                               "-order 2 for curved boundaries)", msh.string());
+    mesh = mesh.quadratic_from_linear();
+  } else if (!taylor_hood && mesh.quadratic()) {
+    mesh_section.fail(mesh_section.has("file") ? "file" : "geo",
+                      "the mesh has 6-node triangles, the P1/P1 fluid needs 3-node ones (or set fluid.element: p2p1)");
+  }
+  return mesh;
+}
+
+// --- physics and numerics ---
+
+// density, viscosity, scheme, nonlinear.
+void read_physics(const ConfigSection& section, bool taylor_hood, FlowParameters& params) {
+  params.density = section.get<double>("density");
+  params.viscosity = section.get<double>("viscosity");
+  if (!(params.density > 0)) section.fail("density", "must be positive");
+  if (!(params.viscosity > 0)) section.fail("viscosity", "must be positive");
+  const auto scheme = section.get<std::string>("scheme", "bdf2");
+  if (scheme == "bdf1") params.scheme = TimeScheme::BDF1;
+  else if (scheme == "bdf2") params.scheme = TimeScheme::BDF2;
+  else if (scheme == "steady") params.scheme = TimeScheme::Steady;
+  else section.fail("scheme", "must be bdf1, bdf2 or steady, got '" + scheme + "'");
+  // Steady Taylor-Hood problems default to Newton (P1/P1: Picard, as validated; newton on request:
+  // the Galerkin Jacobian with Picard stabilisation terms, so it converges fast but not quadratically).
+  std::string method = taylor_hood && params.scheme == TimeScheme::Steady ? "newton" : "picard";
+  if (auto nl = section.optional_child("nonlinear")) {
+    params.max_iterations = nl->get<int>("max_iterations", params.max_iterations);
+    params.tolerance = nl->get<double>("tolerance", params.tolerance);
+    if (params.max_iterations < 1) nl->fail("max_iterations", "must be at least 1");
+    params.relinearise = nl->get<bool>("relinearise", params.relinearise);
+    method = nl->get<std::string>("method", method);
+    if (method != "picard" && method != "newton") nl->fail("method", "must be picard or newton, got '" + method + "'");
+  }
+  params.newton = method == "newton";
+  if (params.scheme == TimeScheme::Steady && params.max_iterations == 1) params.max_iterations = 50;
+}
+
+// fluid.stabilisation: each element's own keys (the other element's are refused).
+void read_stabilisation(const ConfigSection& section, bool taylor_hood, StabilisationParameters& s) {
+  if (taylor_hood) {
+    // Taylor-Hood is inf-sup stable: no PSPG; SUPG and grad-div only when asked for.
+    s.supg = false;
+    s.pspg = false;
+    s.lsic_scale = 0;
+  }
+  const auto st = section.optional_child("stabilisation");
+  if (!st) return;
+  s.supg = st->get<bool>("supg", s.supg);
+  s.viscous_constant = st->get<double>("viscous_constant", s.viscous_constant);
+  s.transient_tau = st->get<bool>("transient_tau", s.transient_tau);
+  if (taylor_hood) {
+    for (const char* key : {"pspg", "lsic_scale", "viscous_residual"})
+      if (st->has(key))
+        st->fail(key, "is a P1/P1 setting; the P2/P1 element takes supg, grad_div, viscous_constant, transient_tau");
+    s.grad_div = st->get<double>("grad_div", s.grad_div);
+    if (s.grad_div < 0) st->fail("grad_div", "must be >= 0");
+  } else {
+    if (st->has("grad_div")) st->fail("grad_div", "is a P2/P1 setting; the P1/P1 element takes lsic_scale");
+    s.pspg = st->get<bool>("pspg", s.pspg);
+    s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
+    s.viscous_residual = st->get<bool>("viscous_residual", s.viscous_residual);
+  }
+}
+
+// threads, umfpack_irstep, linear_solver.
+void read_linear_solver(const ConfigSection& section, bool taylor_hood, FlowParameters& params) {
+  params.threads = section.get<int>("threads", params.threads);
+  params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
+  if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
+  if (taylor_hood) params.strategy = LuStrategy::Symmetric;
+  const auto ls = section.optional_child("linear_solver");
+  if (!ls) return;
+  const auto ordering = ls->get<std::string>("ordering", "auto");
+  if (ordering == "metis") params.ordering = Ordering::Metis;
+  else if (ordering == "amd") params.ordering = Ordering::Amd;
+  else if (ordering == "auto") params.ordering = Ordering::Auto;
+  else ls->fail("ordering", "must be auto, metis or amd, got '" + ordering + "'");
+  const auto strategy = ls->get<std::string>("strategy", taylor_hood ? "symmetric" : "auto");
+  if (strategy == "symmetric") params.strategy = LuStrategy::Symmetric;
+  else if (strategy == "unsymmetric") params.strategy = LuStrategy::Unsymmetric;
+  else if (strategy == "auto") params.strategy = LuStrategy::Auto;
+  else ls->fail("strategy", "must be auto, symmetric or unsymmetric, got '" + strategy + "'");
+  params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
+  params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
+  params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
+  params.krylov_refactor_iterations = ls->get<int>("krylov_refactor_iterations", params.krylov_refactor_iterations);
+  params.adaptive_refactorisation = ls->get<bool>("adaptive_refactorisation", params.adaptive_refactorisation);
+}
+
+// Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's
+// interface.penalty / interface.symmetry are used when the setup gives no penalty
+// (standalone runs). Returns fluid.interface.groups.
+std::vector<std::string> read_nitsche(const ConfigSection& section, const FluidSetup& setup, FlowParameters& params) {
+  params.nitsche_penalty = setup.nitsche_penalty;
+  params.nitsche_symmetry = setup.nitsche_symmetry;
+  const auto iface = section.optional_child("interface");
+  if (!iface) return {};
+  auto groups = string_list(*iface, "groups");
+  const double penalty = iface->get<double>("penalty", setup.nitsche_penalty);
+  const double symmetry = iface->get<double>("symmetry", setup.nitsche_symmetry);
+  if (setup.nitsche_penalty == 0) {
+    params.nitsche_penalty = penalty;
+    params.nitsche_symmetry = symmetry;
+  } else if (penalty != setup.nitsche_penalty || symmetry != setup.nitsche_symmetry) {
+    fsi::logger("fluid")->warn("fluid.interface.penalty/symmetry ({}, {}) differ from the coupler's gamma_N1/gamma_N2 "
+                               "({}, {}); using the coupler's", penalty, symmetry, setup.nitsche_penalty,
+                               setup.nitsche_symmetry);
+  }
+  if (params.nitsche_penalty < 0) iface->fail("penalty", "gamma_N1 must be >= 0");
+  const auto geometry = iface->get<std::string>("penalty_geometry", "current");
+  if (geometry == "step_start") params.penalty_on_step_start = true;
+  else if (geometry != "current")
+    iface->fail("penalty_geometry", "must be 'current' (the interface of this solve) or 'step_start' (of the last "
+                                    "accepted step), got '" + geometry + "'");
+  if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
+  return groups;
+}
+
+const char* scheme_name(TimeScheme scheme) {
+  return scheme == TimeScheme::Steady ? "steady" : scheme == TimeScheme::BDF1 ? "bdf1" : "bdf2";
+}
+
+// --- boundary conditions ---
+
+// The velocity of an inflow entry on `group`: a parabolic or uniform profile along the
+// group's extent (or profile_extent), optionally ramped and pulsating.
+VelocityFunction inflow_velocity(const ConfigSection& inflow, const FluidMesh& mesh, const std::string& group) {
+  const auto profile = inflow.get<std::string>("profile", "parabolic");
+  double umax = 0;
+  if (inflow.has("max_velocity")) umax = inflow.get<double>("max_velocity");
+  else if (inflow.has("mean_velocity")) umax = (profile == "parabolic" ? 1.5 : 1.0) * inflow.get<double>("mean_velocity");
+  else inflow.fail("max_velocity", "give max_velocity or mean_velocity");
+  const Eigen::Vector2d direction = inflow.has("direction") ? vector2(inflow, "direction").normalized() : Eigen::Vector2d(1, 0);
+  const double ramp = inflow.get<double>("ramp_time", 0.0);
+  // Extent of the inlet along its tangent.
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = Eigen::Vector2d::Constant(-1e300);
+  for (int i : mesh.boundary_nodes({group})) {
+    lo = lo.cwiseMin(mesh.nodes.row(i).transpose());
+    hi = hi.cwiseMax(mesh.nodes.row(i).transpose());
+  }
+  // The profile may span more than the group (a half channel with a symmetry line):
+  // profile_extent: [[x0, y0], [x1, y1]] are the ends of the full profile.
+  if (inflow.has("profile_extent")) {
+    const auto ends = inflow.get<std::vector<std::vector<double>>>("profile_extent");
+    if (ends.size() != 2 || ends[0].size() != 2 || ends[1].size() != 2)
+      inflow.fail("profile_extent", "must be [[x0, y0], [x1, y1]]");
+    lo = Eigen::Vector2d(ends[0][0], ends[0][1]);
+    hi = Eigen::Vector2d(ends[1][0], ends[1][1]);
+    if ((hi - lo).norm() <= 0) inflow.fail("profile_extent", "has zero length");
+  }
+  const Eigen::Vector2d tangent = (hi - lo).normalized();
+  const double width = (hi - lo).norm();
+  // pulsation: {mean, amplitude, frequency} multiplies the profile by mean + amplitude sin(2 pi f t).
+  double pulse_mean = 1.0, pulse_amplitude = 0.0, pulse_frequency = 0.0;
+  if (auto pulse = inflow.optional_child("pulsation")) {
+    pulse_mean = pulse->get<double>("mean", 1.0);
+    pulse_amplitude = pulse->get<double>("amplitude");
+    pulse_frequency = pulse->get<double>("frequency");
+  }
+  std::function<double(double)> shape;
+  if (profile == "parabolic") shape = [](double s) { return 4 * s * (1 - s); };
+  else if (profile == "uniform") shape = [](double) { return 1.0; };
+  else inflow.fail("profile", "must be parabolic or uniform, got '" + profile + "'");
+  return [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
+    const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
+    const double factor = ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
+                          (pulse_mean + pulse_amplitude * std::sin(2 * M_PI * pulse_frequency * t));
+    return umax * factor * shape(s) * direction;
+  };
+}
+
 }  // namespace
 
 std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
@@ -97,278 +312,122 @@ NavierStokesFluid::NavierStokesFluid() = default;
 NavierStokesFluid::~NavierStokesFluid() = default;
 
 void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup& setup) {
-  auto log = fsi::logger("fluid");
   setup_ = setup;
-  // --- element ---
-  const auto element = section.get<std::string>("element", "p1p1");
-  if (element != "p1p1" && element != "p2p1") section.fail("element", "must be p1p1 or p2p1, got '" + element + "'");
-  const bool taylor_hood = element == "p2p1";
-  element_ = element;
-
-  // --- mesh ---
+  element_ = section.get<std::string>("element", "p1p1");
+  if (element_ != "p1p1" && element_ != "p2p1") section.fail("element", "must be p1p1 or p2p1, got '" + element_ + "'");
+  const bool taylor_hood = element_ == "p2p1";
   const auto mesh_section = section.child("mesh");
-  std::filesystem::path msh;
-  if (mesh_section.has("file")) {
-    msh = resolve_path(mesh_section, "file");
-  } else {
-    const auto geo = resolve_path(mesh_section, "geo");
-    std::map<std::string, double> parameters;
-    parameters["h"] = mesh_section.get<double>("size");
-    if (!(parameters["h"] > 0)) mesh_section.fail("size", "must be positive");
-    if (auto extra = mesh_section.optional_child("parameters"))
-      for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
-    // One place for every run, so a mesh is made once: $FSI_MESH_CACHE, else
-    // $XDG_CACHE_HOME/fsi/meshes, else ~/.cache/fsi/meshes (entries keyed by a hash of the
-    // .geo text, its parameters and the element order).
-    std::filesystem::path cache;
-    if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env) cache = env;
-    else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) cache = std::filesystem::path(xdg) / "fsi" / "meshes";
-    else if (const char* home = std::getenv("HOME"); home && *home) cache = std::filesystem::path(home) / ".cache" / "fsi" / "meshes";
-    else cache = std::filesystem::temp_directory_path() / "fsi_fluid_meshes";
-    if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
-    msh = mesh_geo(geo, parameters, cache, taylor_hood ? 2 : 1);
-  }
-  const auto domain = string_list(mesh_section, "domain");
-  FluidMesh mesh;
-  try {
-    mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
-  } catch (const fsi::ConfigError&) {
-    throw;
-  } catch (const std::exception& e) {
-    if (mesh_section.has("file")) throw;
-    // The user wrote the .geo: name it, not the cache file gmsh wrote from it.
-    mesh_section.fail("geo", fmt::format("gmsh meshed it, but the mesh cannot be used ({}): a .geo needs a plane "
-                                         "surface and the physical groups of fluid.mesh.domain and the boundaries",
-                                         e.what()));
-  }
-  if (taylor_hood && !mesh.quadratic()) {
-    log->info("fluid: {} has 3-node triangles; the P2/P1 elements get straight edges (mesh with gmsh -order 2 for "
-              "curved boundaries)", msh.string());
-    mesh = mesh.quadratic_from_linear();
-  } else if (!taylor_hood && mesh.quadratic()) {
-    mesh_section.fail(mesh_section.has("file") ? "file" : "geo",
-                      "the mesh has 6-node triangles, the P1/P1 fluid needs 3-node ones (or set fluid.element: p2p1)");
-  }
-
-  // --- physics and numerics ---
+  const auto msh = mesh_file(mesh_section, taylor_hood ? 2 : 1);
+  FluidMesh mesh = read_mesh(mesh_section, msh, taylor_hood);
   FlowParameters params;
-  params.density = section.get<double>("density");
-  params.viscosity = section.get<double>("viscosity");
-  if (!(params.density > 0)) section.fail("density", "must be positive");
-  if (!(params.viscosity > 0)) section.fail("viscosity", "must be positive");
-  const auto scheme = section.get<std::string>("scheme", "bdf2");
-  if (scheme == "bdf1") params.scheme = TimeScheme::BDF1;
-  else if (scheme == "bdf2") params.scheme = TimeScheme::BDF2;
-  else if (scheme == "steady") params.scheme = TimeScheme::Steady;
-  else section.fail("scheme", "must be bdf1, bdf2 or steady, got '" + scheme + "'");
-  // Steady Taylor-Hood problems default to Newton (P1/P1: Picard, as validated; newton on request:
-  // the Galerkin Jacobian with Picard stabilisation terms, so it converges fast but not quadratically).
-  std::string method = taylor_hood && params.scheme == TimeScheme::Steady ? "newton" : "picard";
-  if (auto nl = section.optional_child("nonlinear")) {
-    params.max_iterations = nl->get<int>("max_iterations", params.max_iterations);
-    params.tolerance = nl->get<double>("tolerance", params.tolerance);
-    if (params.max_iterations < 1) nl->fail("max_iterations", "must be at least 1");
-    params.relinearise = nl->get<bool>("relinearise", params.relinearise);
-    method = nl->get<std::string>("method", method);
-    if (method != "picard" && method != "newton") nl->fail("method", "must be picard or newton, got '" + method + "'");
-  }
-  params.newton = method == "newton";
-  if (params.scheme == TimeScheme::Steady && params.max_iterations == 1) params.max_iterations = 50;
-  if (taylor_hood) {
-    // Taylor-Hood is inf-sup stable: no PSPG; SUPG and grad-div only when asked for.
-    params.stabilisation.supg = false;
-    params.stabilisation.pspg = false;
-    params.stabilisation.lsic_scale = 0;
-  }
-  if (auto st = section.optional_child("stabilisation")) {
-    auto& s = params.stabilisation;
-    s.supg = st->get<bool>("supg", s.supg);
-    s.viscous_constant = st->get<double>("viscous_constant", s.viscous_constant);
-    s.transient_tau = st->get<bool>("transient_tau", s.transient_tau);
-    if (taylor_hood) {
-      for (const char* key : {"pspg", "lsic_scale", "viscous_residual"})
-        if (st->has(key))
-          st->fail(key, "is a P1/P1 setting; the P2/P1 element takes supg, grad_div, viscous_constant, transient_tau");
-      s.grad_div = st->get<double>("grad_div", s.grad_div);
-      if (s.grad_div < 0) st->fail("grad_div", "must be >= 0");
-    } else {
-      if (st->has("grad_div")) st->fail("grad_div", "is a P2/P1 setting; the P1/P1 element takes lsic_scale");
-      s.pspg = st->get<bool>("pspg", s.pspg);
-      s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
-      s.viscous_residual = st->get<bool>("viscous_residual", s.viscous_residual);
-    }
-  }
-  params.threads = section.get<int>("threads", params.threads);
-  params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
-  if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
-  if (taylor_hood) params.strategy = LuStrategy::Symmetric;
-  if (auto ls = section.optional_child("linear_solver")) {
-    const auto ordering = ls->get<std::string>("ordering", "auto");
-    if (ordering == "metis") params.ordering = Ordering::Metis;
-    else if (ordering == "amd") params.ordering = Ordering::Amd;
-    else if (ordering == "auto") params.ordering = Ordering::Auto;
-    else ls->fail("ordering", "must be auto, metis or amd, got '" + ordering + "'");
-    const auto strategy = ls->get<std::string>("strategy", taylor_hood ? "symmetric" : "auto");
-    if (strategy == "symmetric") params.strategy = LuStrategy::Symmetric;
-    else if (strategy == "unsymmetric") params.strategy = LuStrategy::Unsymmetric;
-    else if (strategy == "auto") params.strategy = LuStrategy::Auto;
-    else ls->fail("strategy", "must be auto, symmetric or unsymmetric, got '" + strategy + "'");
-    params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
-    params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
-    params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
-    params.krylov_refactor_iterations = ls->get<int>("krylov_refactor_iterations", params.krylov_refactor_iterations);
-    params.adaptive_refactorisation = ls->get<bool>("adaptive_refactorisation", params.adaptive_refactorisation);
-  }
+  read_physics(section, taylor_hood, params);
+  read_stabilisation(section, taylor_hood, params.stabilisation);
+  read_linear_solver(section, taylor_hood, params);
+  const auto interface_groups = read_nitsche(section, setup, params);
+  solver_ = std::make_unique<FlowSolver>(std::move(mesh), params, element_);
+  const auto& fluid_mesh = solver_->mesh();
 
-  // Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's
-  // interface.penalty / interface.symmetry are used when the setup gives no penalty
-  // (standalone runs).
-  std::vector<std::string> interface_groups;
-  params.nitsche_penalty = setup.nitsche_penalty;
-  params.nitsche_symmetry = setup.nitsche_symmetry;
-  if (auto iface = section.optional_child("interface")) {
-    interface_groups = string_list(*iface, "groups");
-    const double penalty = iface->get<double>("penalty", setup.nitsche_penalty);
-    const double symmetry = iface->get<double>("symmetry", setup.nitsche_symmetry);
-    if (setup.nitsche_penalty == 0) {
-      params.nitsche_penalty = penalty;
-      params.nitsche_symmetry = symmetry;
-    } else if (penalty != setup.nitsche_penalty || symmetry != setup.nitsche_symmetry) {
-      log->warn("fluid.interface.penalty/symmetry ({}, {}) differ from the coupler's gamma_N1/gamma_N2 ({}, {}); "
-                "using the coupler's", penalty, symmetry, setup.nitsche_penalty, setup.nitsche_symmetry);
-    }
-    if (params.nitsche_penalty < 0) iface->fail("penalty", "gamma_N1 must be >= 0");
-    const auto geometry = iface->get<std::string>("penalty_geometry", "current");
-    if (geometry == "step_start") params.penalty_on_step_start = true;
-    else if (geometry != "current")
-      iface->fail("penalty_geometry", "must be 'current' (the interface of this solve) or 'step_start' (of the last "
-                                      "accepted step), got '" + geometry + "'");
-    if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
-  }
-
-  if (taylor_hood) solver_ = std::make_unique<TaylorHoodSolver>(mesh, params);
-  else solver_ = std::make_unique<NavierStokesSolver>(mesh, params);
-  auto& solver = *solver_;
-  const auto& fluid_mesh = solver.mesh();
-
-  // --- boundary conditions ---
-  std::vector<std::string> fixed_groups;
-  for (const auto& inflow : section.list("inflow")) {
-    const auto group = inflow.get<std::string>("group");
-    fixed_groups.push_back(group);
-    if (!fluid_mesh.has_boundary(group)) inflow.fail("group", "no boundary group '" + group + "' in " + msh.string());
-    const auto profile = inflow.get<std::string>("profile", "parabolic");
-    double umax = 0;
-    if (inflow.has("max_velocity")) umax = inflow.get<double>("max_velocity");
-    else if (inflow.has("mean_velocity")) umax = (profile == "parabolic" ? 1.5 : 1.0) * inflow.get<double>("mean_velocity");
-    else inflow.fail("max_velocity", "give max_velocity or mean_velocity");
-    const Eigen::Vector2d direction = inflow.has("direction") ? vector2(inflow, "direction").normalized() : Eigen::Vector2d(1, 0);
-    const double ramp = inflow.get<double>("ramp_time", 0.0);
-    // Extent of the inlet along its tangent.
-    const auto nodes = fluid_mesh.boundary_nodes({group});
-    Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = Eigen::Vector2d::Constant(-1e300);
-    for (int i : nodes) {
-      lo = lo.cwiseMin(fluid_mesh.nodes.row(i).transpose());
-      hi = hi.cwiseMax(fluid_mesh.nodes.row(i).transpose());
-    }
-    // The profile may span more than the group (a half channel with a symmetry line):
-    // profile_extent: [[x0, y0], [x1, y1]] are the ends of the full profile.
-    if (inflow.has("profile_extent")) {
-      const auto ends = inflow.get<std::vector<std::vector<double>>>("profile_extent");
-      if (ends.size() != 2 || ends[0].size() != 2 || ends[1].size() != 2)
-        inflow.fail("profile_extent", "must be [[x0, y0], [x1, y1]]");
-      lo = Eigen::Vector2d(ends[0][0], ends[0][1]);
-      hi = Eigen::Vector2d(ends[1][0], ends[1][1]);
-      if ((hi - lo).norm() <= 0) inflow.fail("profile_extent", "has zero length");
-    }
-    const Eigen::Vector2d tangent = (hi - lo).normalized();
-    const double width = (hi - lo).norm();
-    // pulsation: {mean, amplitude, frequency} multiplies the profile by mean + amplitude sin(2 pi f t).
-    double pulse_mean = 1.0, pulse_amplitude = 0.0, pulse_frequency = 0.0;
-    if (auto pulse = inflow.optional_child("pulsation")) {
-      pulse_mean = pulse->get<double>("mean", 1.0);
-      pulse_amplitude = pulse->get<double>("amplitude");
-      pulse_frequency = pulse->get<double>("frequency");
-    }
-    std::function<double(double)> shape;
-    if (profile == "parabolic") shape = [](double s) { return 4 * s * (1 - s); };
-    else if (profile == "uniform") shape = [](double) { return 1.0; };
-    else inflow.fail("profile", "must be parabolic or uniform, got '" + profile + "'");
-    solver.add_dirichlet(group, [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
-      const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
-      const double factor = ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
-                            (pulse_mean + pulse_amplitude * std::sin(2 * M_PI * pulse_frequency * t));
-      return umax * factor * shape(s) * direction;
-    });
-  }
-  for (const auto& g : string_list(section, "walls")) {
-    if (!fluid_mesh.has_boundary(g)) section.fail("walls", "no boundary group '" + g + "' in " + msh.string());
-    solver.add_dirichlet(g, [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
-    fixed_groups.push_back(g);
-  }
-  for (const auto& mw : section.list("moving_walls")) {
-    const auto g = mw.get<std::string>("group");
-    if (!fluid_mesh.has_boundary(g)) mw.fail("group", "no boundary group '" + g + "' in " + msh.string());
-    const Eigen::Vector2d v = vector2(mw, "velocity");
-    solver.add_dirichlet(g, [v](const Eigen::Vector2d&, double) { return v; });
-    fixed_groups.push_back(g);
-  }
-  for (const auto& g : string_list(section, "symmetry")) {
-    if (!fluid_mesh.has_boundary(g)) section.fail("symmetry", "no boundary group '" + g + "' in " + msh.string());
-    solver.add_symmetry(g);
-    fixed_groups.push_back(g);
-  }
-  for (const auto& g : string_list(section, "outlet")) {
-    if (!fluid_mesh.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh.string());
-    fixed_groups.push_back(g);
-  }
-  if (auto pr = section.optional_child("pressure_reference"))
-    solver.set_pressure_reference(vector2(*pr, "point"), [v = pr->get<double>("value", 0.0)](double) { return v; });
+  const auto fixed_groups = add_boundary_conditions(section, msh.string());
   for (const auto& g : fluid_mesh.boundaries)
     if (std::find(fixed_groups.begin(), fixed_groups.end(), g.first) == fixed_groups.end() &&
         std::find(interface_groups.begin(), interface_groups.end(), g.first) == interface_groups.end())
-      log->warn("boundary group '{}' has no condition: it is a do-nothing boundary", g.first);
-  if (!interface_groups.empty()) {
-    for (const auto& g : interface_groups)
-      if (!fluid_mesh.has_boundary(g)) section.child("interface").fail("groups", "no boundary group '" + g + "'");
-    solver.set_interface(interface_groups);
-    const auto iface = section.child("interface");
-    MeshMotionOptions motion;
-    motion.stiffening = iface.get<double>("mesh_stiffening", 1.0);
-    const auto method = iface.get<std::string>("mesh_motion", "harmonic");
-    if (method == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
-    else if (method != "harmonic") iface.fail("mesh_motion", "must be 'harmonic' or 'elastic'");
-    motion.incremental = iface.get<bool>("mesh_incremental", false);
-    // P2 meshes: the interface midpoints take the solid's displacement (curved interface
-    // edges follow the solid); the extension runs either on the vertices (default: interior
-    // midpoints move with the mean of their edge's vertices, edges stay straight inside) or on
-    // the 4-triangle refinement of every element (every node extended; 4x the unknowns).
-    const auto on = fluid_mesh.quadratic() ? iface.get<std::string>("mesh_motion_nodes", "vertices") : "all";
-    if (fluid_mesh.quadratic() && on != "vertices" && on != "all")
-      iface.fail("mesh_motion_nodes", "must be 'vertices' or 'all', got '" + on + "'");
-    motion_on_vertices_ = fluid_mesh.quadratic() && on == "vertices";
-    std::vector<int> moving = solver.interface_nodes(), fixed = fluid_mesh.boundary_nodes(fixed_groups);
-    if (motion_on_vertices_) {
-      const int nv = fluid_mesh.vertices();
-      motion_mesh_.nodes = fluid_mesh.nodes.topRows(nv);
-      motion_mesh_.triangles = fluid_mesh.triangles;
-      motion_mesh_.boundaries = fluid_mesh.boundaries;
-      motion_vertex_index_.clear();
-      std::vector<int> vertex_nodes;
-      for (std::size_t i = 0; i < moving.size(); ++i)
-        if (moving[i] < nv) {
-          motion_vertex_index_.push_back(static_cast<int>(i));
-          vertex_nodes.push_back(moving[i]);
-        }
-      moving = vertex_nodes;
-      fixed.erase(std::remove_if(fixed.begin(), fixed.end(), [nv](int n) { return n >= nv; }), fixed.end());
-    } else {
-      motion_mesh_ = fluid_mesh.linear_refinement();
-    }
-    motion_ = std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion);  // keeps a pointer to motion_mesh_
-  }
+      fsi::logger("fluid")->warn("boundary group '{}' has no condition: it is a do-nothing boundary", g.first);
+  if (!interface_groups.empty()) configure_mesh_motion(section, interface_groups, fixed_groups);
+  configure_output(section, params.density);
 
-  // --- probes and output ---
+  fsi::logger("fluid")->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, "
+                             "mesh {}", element_, taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(),
+                             fluid_mesh.triangle_count(), solver_->dofs(), scheme_name(params.scheme),
+                             params.newton ? "newton" : "picard", solver_->interface_nodes().size(), msh.string());
+  start_ = last_log_ = std::chrono::steady_clock::now();
+}
+
+// fluid.inflow, walls, moving_walls, symmetry, outlet and pressure_reference on the solver.
+// Returns the groups with a condition (the mesh motion holds them fixed).
+std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const ConfigSection& section, const std::string& msh) {
+  auto& solver = *solver_;
+  const auto& mesh = solver.mesh();
+  std::vector<std::string> fixed;
+  for (const auto& inflow : section.list("inflow")) {
+    const auto group = inflow.get<std::string>("group");
+    fixed.push_back(group);
+    if (!mesh.has_boundary(group)) inflow.fail("group", "no boundary group '" + group + "' in " + msh);
+    solver.add_dirichlet(group, inflow_velocity(inflow, mesh, group));
+  }
+  for (const auto& g : string_list(section, "walls")) {
+    if (!mesh.has_boundary(g)) section.fail("walls", "no boundary group '" + g + "' in " + msh);
+    solver.add_dirichlet(g, [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
+    fixed.push_back(g);
+  }
+  for (const auto& mw : section.list("moving_walls")) {
+    const auto g = mw.get<std::string>("group");
+    if (!mesh.has_boundary(g)) mw.fail("group", "no boundary group '" + g + "' in " + msh);
+    const Eigen::Vector2d v = vector2(mw, "velocity");
+    solver.add_dirichlet(g, [v](const Eigen::Vector2d&, double) { return v; });
+    fixed.push_back(g);
+  }
+  for (const auto& g : string_list(section, "symmetry")) {
+    if (!mesh.has_boundary(g)) section.fail("symmetry", "no boundary group '" + g + "' in " + msh);
+    solver.add_symmetry(g);
+    fixed.push_back(g);
+  }
+  for (const auto& g : string_list(section, "outlet")) {
+    if (!mesh.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh);
+    fixed.push_back(g);
+  }
+  if (auto pr = section.optional_child("pressure_reference"))
+    solver.set_pressure_reference(vector2(*pr, "point"), [v = pr->get<double>("value", 0.0)](double) { return v; });
+  return fixed;
+}
+
+// The Nitsche interface and the mesh motion (fluid.interface): the extension of the interface
+// displacement into the mesh, the groups with conditions held fixed.
+void NavierStokesFluid::configure_mesh_motion(const ConfigSection& section, const std::vector<std::string>& groups,
+                                              const std::vector<std::string>& fixed_groups) {
+  const auto& fluid_mesh = solver_->mesh();
+  const auto iface = section.child("interface");
+  for (const auto& g : groups)
+    if (!fluid_mesh.has_boundary(g)) iface.fail("groups", "no boundary group '" + g + "'");
+  solver_->set_interface(groups);
+  MeshMotionOptions motion;
+  motion.stiffening = iface.get<double>("mesh_stiffening", 1.0);
+  const auto method = iface.get<std::string>("mesh_motion", "harmonic");
+  if (method == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
+  else if (method != "harmonic") iface.fail("mesh_motion", "must be 'harmonic' or 'elastic'");
+  motion.incremental = iface.get<bool>("mesh_incremental", false);
+  // P2 meshes: the interface midpoints take the solid's displacement (curved interface
+  // edges follow the solid); the extension runs either on the vertices (default: interior
+  // midpoints move with the mean of their edge's vertices, edges stay straight inside) or on
+  // the 4-triangle refinement of every element (every node extended; 4x the unknowns).
+  const auto on = fluid_mesh.quadratic() ? iface.get<std::string>("mesh_motion_nodes", "vertices") : "all";
+  if (fluid_mesh.quadratic() && on != "vertices" && on != "all")
+    iface.fail("mesh_motion_nodes", "must be 'vertices' or 'all', got '" + on + "'");
+  motion_on_vertices_ = fluid_mesh.quadratic() && on == "vertices";
+  std::vector<int> moving = solver_->interface_nodes(), fixed = fluid_mesh.boundary_nodes(fixed_groups);
+  if (motion_on_vertices_) {
+    const int nv = fluid_mesh.vertices();
+    motion_mesh_.nodes = fluid_mesh.nodes.topRows(nv);
+    motion_mesh_.triangles = fluid_mesh.triangles;
+    motion_mesh_.boundaries = fluid_mesh.boundaries;
+    motion_vertex_index_.clear();
+    std::vector<int> vertex_nodes;
+    for (std::size_t i = 0; i < moving.size(); ++i)
+      if (moving[i] < nv) {
+        motion_vertex_index_.push_back(static_cast<int>(i));
+        vertex_nodes.push_back(moving[i]);
+      }
+    moving = vertex_nodes;
+    fixed.erase(std::remove_if(fixed.begin(), fixed.end(), [nv](int n) { return n >= nv; }), fixed.end());
+  } else {
+    motion_mesh_ = fluid_mesh.linear_refinement();
+  }
+  motion_ = std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion);  // keeps a pointer to motion_mesh_
+}
+
+// Force probes, pressure probes and differences, VTK (fluid.forces, pressure_probes,
+// pressure_differences, output).
+void NavierStokesFluid::configure_output(const ConfigSection& section, double density) {
+  const auto& fluid_mesh = solver_->mesh();
   for (const auto& f : section.list("forces")) {
     ForceProbe probe;
     probe.name = f.get<std::string>("name", "");
@@ -377,7 +436,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
       if (!fluid_mesh.has_boundary(g)) f.fail("groups", "no boundary group '" + g + "'");
     if (f.has("reference_velocity")) {
       const double u = f.get<double>("reference_velocity"), l = f.get<double>("reference_length");
-      probe.coefficient_scale = 2.0 / (params.density * u * u * l);
+      probe.coefficient_scale = 2.0 / (density * u * u * l);
     }
     forces_.push_back(probe);
   }
@@ -398,12 +457,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
     vtk_every_ = out->get<int>("vtk_every", -1);
     if (vtk_every_ < 0 && out->has("vtk_every")) out->fail("vtk_every", "must be >= 0 (0 = never)");
   }
-  if (vtk_every_ != 0 && !setup.output_dir.empty()) vtk_ = PvdSeries(setup.output_dir, "fluid");
-
-  log->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, mesh {}", element,
-            taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(), fluid_mesh.triangle_count(), solver.dofs(),
-            scheme, method, solver.interface_nodes().size(), msh.string());
-  start_ = last_log_ = std::chrono::steady_clock::now();
+  if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid");
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {
@@ -420,9 +474,7 @@ Eigen::MatrixX2d NavierStokesFluid::extend(const Eigen::VectorXd& interface_disp
   const auto& mesh = solver_->mesh();
   Eigen::MatrixX2d out(mesh.node_count(), 2);
   out.topRows(mesh.vertices()) = vertex;
-  for (int e = 0; e < mesh.triangle_count(); ++e)
-    for (int k = 0; k < 3; ++k)
-      out.row(mesh.edge_nodes(e, k)) = 0.5 * (vertex.row(mesh.triangles(e, k)) + vertex.row(mesh.triangles(e, (k + 1) % 3)));
+  mesh.interpolate_midpoints(out);
   const auto& nodes = solver_->interface_nodes();
   for (std::size_t i = 0; i < nodes.size(); ++i)
     out.row(nodes[i]) = interface_displacement.segment<2>(2 * static_cast<Eigen::Index>(i)).transpose();

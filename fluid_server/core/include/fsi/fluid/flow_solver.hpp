@@ -1,13 +1,29 @@
 #pragma once
-// What both fluid discretisations share: the parameters of a flow solve, the report of one
-// solve, and the interface NavierStokesFluid drives (FlowSolver), implemented by
-//   NavierStokesSolver  - equal-order P1/P1 with SUPG/PSPG/LSIC (the seed paper's element)
-//   TaylorHoodSolver    - isoparametric Taylor-Hood P2/P1 (inf-sup stable; optional SUPG, grad-div)
-// Pure numerics: Eigen in, Eigen out; no configuration files, sockets or output.
+// The fluid solver: Navier-Stokes in ALE form on a (moving) triangle mesh, with strong
+// Dirichlet and symmetry conditions, do-nothing outlets, a Nitsche interface, BDF1/BDF2,
+// Picard or Newton iterations, UMFPACK (sparse_lu.hpp) and consistent reaction forces. One
+// time-stepping, assembly, interface and checkpoint path for both elements:
+//   "p1p1" - equal-order P1/P1 with SUPG/PSPG/LSIC (the seed paper's element; NavierStokesSolver)
+//   "p2p1" - isoparametric Taylor-Hood P2/P1 (inf-sup stable; optional SUPG, grad-div; TaylorHoodSolver)
+// whose element parts (local assembly, DOF layout, interface traces, output) sit behind one
+// interface (src/flow_element.hpp). Pure numerics: Eigen in, Eigen out; no configuration
+// files, sockets or output. NavierStokesFluid (navier_stokes_fluid.hpp) wraps it for scenes.
+//
+// Use:
+//   FlowSolver solver(mesh, params, "p1p1");
+//   solver.add_dirichlet("inlet", profile);  solver.add_dirichlet("walls", zero);
+//   solver.set_interface({"flag"});                    // Nitsche groups (optional)
+//   for each step:  solver.solve(t, dt, positions, interface_velocity);  (repeatable)
+//                   solver.accept();
+//
+// Linearisation: per solve, `max_iterations` Picard (Oseen) or Newton iterations; the first
+// one advects with the extrapolated velocity (BDF2: (1+w) u_n - w u_{n-1}), so one iteration
+// per step is the second-order semi-implicit scheme (one factorisation per step).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -89,55 +105,87 @@ struct StepReport {
 
 class FlowSolver {
  public:
-  virtual ~FlowSolver() = default;
+  // `element`: "p1p1" (3-node triangles) or "p2p1" (6-node triangles; a linear mesh gets
+  // straight midpoints). std::invalid_argument when the mesh does not suit the element.
+  FlowSolver(FluidMesh mesh, FlowParameters params, const std::string& element);
+  ~FlowSolver();
+  FlowSolver(FlowSolver&&) noexcept;
+  FlowSolver& operator=(FlowSolver&&) noexcept;
 
   // --- set-up (before the first solve) ---
-  virtual void add_dirichlet(const std::string& group, VelocityFunction velocity) = 0;  // strong, both components
-  virtual void add_symmetry(const std::string& group) = 0;                              // u.n = 0 (axis-aligned)
-  virtual void set_interface(const std::vector<std::string>& groups) = 0;               // Nitsche groups
-  virtual void set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value) = 0;
-  virtual void set_body_force(VelocityFunction force) = 0;
+  void add_dirichlet(const std::string& group, VelocityFunction velocity);  // strong, both components
+  void add_symmetry(const std::string& group);                              // u.n = 0 (axis-aligned)
+  void set_interface(const std::vector<std::string>& groups);               // Nitsche groups
+  void set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value);  // nearest vertex
+  void set_body_force(VelocityFunction force);
+  void set_initial_velocity(const Eigen::MatrixX2d& velocity);  // per node
 
   // --- stepping ---
   // Solves time level `time` (= t_n + dt) from the accepted state, on the mesh at `positions`
   // (every node, current configuration), with the interface velocity per interface node
   // (interleaved, 2 * interface_nodes().size(); empty = zero). Repeatable before accept().
-  virtual StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions,
-                           const Eigen::VectorXd& interface_velocity) = 0;
-  virtual void accept() = 0;
+  StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity);
+  void accept();
 
   // --- checkpoints (after accept()) ---
-  // Writes everything the next solve depends on under `prefix` (e.g. "flow.": flow.u,
-  // flow.u_n, flow.x_n, flow.lu.ordering, ...) and drops the LU factors, so that the next
-  // solve refactorises, exactly as a solver restored from this state does.
-  virtual void save_state(StateArchive& state, const std::string& prefix) = 0;
+  // Writes everything the next solve depends on under `prefix` (e.g. "flow.": flow.element,
+  // flow.u, flow.u_n, flow.x_n, ..., and the linear solver's flow.lu.ordering) and drops the LU
+  // factors, so that the next solve refactorises, exactly as a solver restored from this state does.
+  void save_state(StateArchive& state, const std::string& prefix);
   // On a solver set up like the saved one (same mesh, conditions and parameters), before any
   // solve: continues bit for bit as the saved one. fsi::StateError (naming the entry) when
-  // the state does not fit (another element or mesh).
-  virtual void load_state(const StateArchive& state, const std::string& prefix) = 0;
+  // the state does not fit (another element or mesh); the solver is then unchanged.
+  void load_state(const StateArchive& state, const std::string& prefix);
 
   // --- results of the last solve ---
-  virtual const FluidMesh& mesh() const = 0;
-  virtual const FlowParameters& parameters() const = 0;
-  virtual int dofs() const = 0;
-  virtual Eigen::MatrixX2d velocity() const = 0;  // per node
-  virtual Eigen::VectorXd pressure() const = 0;   // per node (P2/P1: linear between the vertices)
-  virtual const Eigen::MatrixX2d& positions() const = 0;
-  // Force of the fluid on the body bounded by the groups (consistent reaction forces).
-  virtual Eigen::Vector2d force(const std::vector<std::string>& groups) const = 0;
+  const FluidMesh& mesh() const;
+  const FlowParameters& parameters() const { return params_; }
+  int dofs() const;
+  // Every unknown: P1/P1 (u, v, p) per node; P2/P1 (u, v) per node at 2 i, 2 i + 1, then p per vertex.
+  const Eigen::VectorXd& solution() const { return U_; }
+  const Eigen::VectorXd& reaction() const { return reaction_; }  // K_vol U - F_vol, every unknown
+  // The system of the last solve (constraints applied) and its right-hand side (benchmarks).
+  const Eigen::SparseMatrix<double>& last_matrix() const;
+  const Eigen::VectorXd& last_rhs() const;
+  Eigen::MatrixX2d velocity() const;  // per node
+  Eigen::VectorXd pressure() const;   // per node (P2/P1: linear between the vertices)
+  const Eigen::MatrixX2d& positions() const { return X_; }
+  const Eigen::MatrixX2d& accepted_positions() const { return X_n_; }
+  // Force of the fluid on the body bounded by the groups: minus the sum of the momentum
+  // reactions (residual of the volume terms) over the groups' nodes (consistent reaction forces).
+  Eigen::Vector2d force(const std::vector<std::string>& groups) const;
   // Interface nodes (P2/P1: vertices and edge midpoints) and their segments (local indices;
   // P2/P1: every edge split at its midpoint).
-  virtual const std::vector<int>& interface_nodes() const = 0;
-  virtual const IndexMatrix2& interface_segments() const = 0;
-  // f_sigma = int N^T sigma n, f_v = int N^T v_f at the interface nodes (current configuration).
-  virtual Eigen::VectorXd interface_traction() const = 0;
-  virtual Eigen::VectorXd interface_velocity_integral() const = 0;
+  const std::vector<int>& interface_nodes() const { return interface_nodes_; }
+  const IndexMatrix2& interface_segments() const { return interface_segments_; }
+  // f_sigma = int N^T sigma n (n = fluid outward normal), the reaction plus the penalty term
+  // gamma_N1 int N^T (v_f - v_s); f_v = int N^T v_f at the interface nodes (current configuration).
+  Eigen::VectorXd interface_traction() const;
+  Eigen::VectorXd interface_velocity_integral() const;
   // M_f = int N_i N_j dgamma over the interface in the configuration of the last solve, with
   // the quadrature of the Nitsche terms (a scalar matrix on the interface nodes): f_v = M_f v_f
   // and the penalty part of f_sigma is gamma_N1 M_f (v_f - v_s).
-  virtual Eigen::SparseMatrix<double> interface_mass() const = 0;
-  virtual double pressure_at(const Eigen::Vector2d& point) const = 0;  // NaN outside the mesh
-  virtual Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const = 0;
+  Eigen::SparseMatrix<double> interface_mass() const;
+  double pressure_at(const Eigen::Vector2d& point) const;  // NaN outside the mesh
+  Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const;
+
+ private:
+  struct Impl;
+  struct Step;
+  FlowParameters params_;
+  std::unique_ptr<Impl> impl_;
+  Eigen::VectorXd U_, U_n_, U_nm1_, reaction_;
+  Eigen::MatrixX2d X_, X_n_, X_nm1_;
+  double dt_n_ = 0;      // last accepted step size
+  double dt_trial_ = 0;  // step size of the last solve
+  int accepted_ = 0;
+  int trial_solves_ = 0;  // solves of the current time level since the last accept()
+  std::vector<int> interface_nodes_;
+  IndexMatrix2 interface_segments_;
+  Eigen::VectorXd interface_velocity_;  // of the last solve
+  Step begin_step(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity);
+  void assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report);
+  bool locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const;
 };
 
 }  // namespace fsi::fluid

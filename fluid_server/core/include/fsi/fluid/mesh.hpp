@@ -41,6 +41,16 @@ struct FluidMesh {
   // The 6 nodes of triangle e (vertices 0-2, then the midpoints of edges 01, 12, 20).
   Eigen::Matrix<int, 6, 1> element_nodes6(int e) const;
 
+  // Quadratic meshes: the row of every edge midpoint in `values` (one row per node) becomes the
+  // mean of its two vertices' rows (straight edges). Linear meshes: nothing to do.
+  template <class Values>
+  void interpolate_midpoints(Values& values) const {
+    if (!quadratic()) return;
+    for (int e = 0; e < triangle_count(); ++e)
+      for (int k = 0; k < 3; ++k)
+        values.row(edge_nodes(e, k)) = 0.5 * (values.row(triangles(e, k)) + values.row(triangles(e, (k + 1) % 3)));
+  }
+
   // A quadratic mesh with straight edges (midpoints at the edge centres) from a linear one.
   FluidMesh quadratic_from_linear() const;
   // A quadratic mesh cut into 4 linear triangles per element on the same nodes (mesh motion,

@@ -1,7 +1,7 @@
 #pragma once
 // fsi::FluidModel for `fluid: {model: fem, ...}`: reads the scene keys (documented in
 // configs/dfg_2d1.yaml and docs/fluid.md), meshes the .geo with the gmsh CLI (cached),
-// runs NavierStokesSolver (fluid.element: p1p1) or TaylorHoodSolver (p2p1), moves the mesh by a harmonic extension of the interface
+// runs FlowSolver with fluid.element p1p1 or p2p1, moves the mesh by a harmonic extension of the interface
 // displacement, and reports drag/lift (consistent reactions), pressure probes, VTK.
 //
 // Call order (fsi::FluidModel): configure -> interface -> {solve_step ... accept_step} -> write_output.
@@ -82,6 +82,11 @@ class NavierStokesFluid : public FluidModel {
   FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
   bool motion_on_vertices_ = false;
   std::vector<int> motion_vertex_index_;  // P2 on vertices: interface index of each moving vertex
+  // configure's parts (the scene keys they read: navier_stokes_fluid.cpp).
+  std::vector<std::string> add_boundary_conditions(const ConfigSection& section, const std::string& msh);
+  void configure_mesh_motion(const ConfigSection& section, const std::vector<std::string>& groups,
+                             const std::vector<std::string>& fixed_groups);
+  void configure_output(const ConfigSection& section, double density);
   Eigen::VectorXd motion_input(const Eigen::VectorXd& interface_displacement) const;
   Eigen::MatrixX2d extend(const Eigen::VectorXd& interface_displacement) const;  // every node
   std::unique_ptr<MeshMotion> motion_;

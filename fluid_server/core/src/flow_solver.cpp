@@ -1,0 +1,586 @@
+// FlowSolver: the time stepping, nonlinear iterations, global assembly, Nitsche interface,
+// linear solves, reactions and checkpoints of both elements; the element parts are
+// flow_element_p1p1.cpp and flow_element_p2p1.cpp (flow_element.hpp).
+#include "fsi/fluid/flow_solver.hpp"
+
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+#include "fsi/common/solver_model.hpp"
+#include "fsi/fluid/sparse_lu.hpp"
+#include "flow_element.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace fsi::fluid {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct DirichletCondition {
+  std::vector<int> nodes;
+  VelocityFunction velocity;
+};
+
+struct SymmetryCondition {
+  std::vector<int> nodes;
+  int component;  // constrained velocity component (normal to the boundary)
+};
+
+// The strong constraints at `time` on the positions X: which unknowns, and their values.
+struct StrongConstraints {
+  std::vector<char> on;
+  Eigen::VectorXd value;
+};
+
+// pressure_dof < 0: no pressure reference.
+StrongConstraints strong_constraints(const detail::DofLayout& dof, const std::vector<DirichletCondition>& dirichlet,
+                                     const std::vector<SymmetryCondition>& symmetry, const Eigen::MatrixX2d& X,
+                                     double time, int pressure_dof, double pressure_value) {
+  StrongConstraints k{std::vector<char>(static_cast<std::size_t>(dof.dofs), 0), Eigen::VectorXd::Zero(dof.dofs)};
+  for (const auto& sym : symmetry)
+    for (int node : sym.nodes) k.on[static_cast<std::size_t>(dof.velocity(node, sym.component))] = 1;
+  for (const auto& dc : dirichlet)
+    for (int node : dc.nodes) {
+      const Eigen::Vector2d v = dc.velocity(X.row(node).transpose(), time);
+      for (int c = 0; c < 2; ++c) {
+        k.on[static_cast<std::size_t>(dof.velocity(node, c))] = 1;
+        k.value(dof.velocity(node, c)) = v(c);
+      }
+    }
+  if (pressure_dof >= 0) {
+    k.on[static_cast<std::size_t>(pressure_dof)] = 1;
+    k.value(pressure_dof) = pressure_value;
+  }
+  return k;
+}
+
+// Strong constraints: the constrained rows of A become identity rows, their rhs the value.
+void apply_constraints(Eigen::SparseMatrix<double>& A, Eigen::VectorXd& rhs, const StrongConstraints& k) {
+  const int* outer = A.outerIndexPtr();
+  const int* inner = A.innerIndexPtr();
+  double* av = A.valuePtr();
+  for (Eigen::Index col = 0; col < A.cols(); ++col)
+    for (int j = outer[col]; j < outer[col + 1]; ++j)
+      if (k.on[static_cast<std::size_t>(inner[j])]) av[j] = inner[j] == col ? 1.0 : 0.0;
+  for (Eigen::Index d = 0; d < rhs.size(); ++d)
+    if (k.on[static_cast<std::size_t>(d)]) rhs(d) = k.value(d);
+}
+
+// du/dt ~ (alpha0 u + alpha1 u_n + alpha2 u_{n-1}) / dt; the semi-implicit advection velocity
+// u* = (1 + extrap) u_n - extrap u_{n-1}. BDF2 with variable steps (first step BDF1).
+struct BdfCoefficients {
+  double alpha0 = 0, alpha1 = 0, alpha2 = 0, extrap = 0;
+};
+
+BdfCoefficients bdf_coefficients(TimeScheme scheme, int accepted_steps, double dt, double dt_previous) {
+  BdfCoefficients c;
+  if (scheme == TimeScheme::Steady) return c;
+  if (scheme == TimeScheme::BDF2 && accepted_steps >= 1 && dt_previous > 0) {
+    const double w = dt / dt_previous;
+    c.alpha0 = (1 + 2 * w) / (1 + w);
+    c.alpha1 = -(1 + w);
+    c.alpha2 = w * w / (1 + w);
+    c.extrap = w;
+  } else {
+    c.alpha0 = 1;
+    c.alpha1 = -1;
+  }
+  return c;
+}
+
+// The velocity component a symmetry group constrains: 1 (v) on y = const, 0 (u) on x = const.
+int symmetry_component(const FluidMesh& mesh, const std::string& group) {
+  const auto& seg = mesh.boundary(group);
+  Eigen::Vector2d span = Eigen::Vector2d::Zero();
+  for (Eigen::Index e = 0; e < seg.rows(); ++e)
+    span += (mesh.nodes.row(seg(e, 1)) - mesh.nodes.row(seg(e, 0))).transpose().cwiseAbs();
+  const double tol = 1e-8 * span.norm();
+  if (span.y() <= tol) return 1;
+  if (span.x() <= tol) return 0;
+  throw std::runtime_error("symmetry boundary '" + group + "' is not axis-aligned (only x = const or y = const)");
+}
+
+// ||u_new - u_old|| / ||u_new|| over the velocity unknowns.
+double relative_velocity_change(const Eigen::VectorXd& u_new, const Eigen::VectorXd& u_old, int nodes,
+                                const detail::DofLayout& dof) {
+  double diff = 0, norm = 0;
+  for (int i = 0; i < nodes; ++i)
+    for (int c = 0; c < 2; ++c) {
+      const int k = dof.velocity(i, c);
+      diff += std::pow(u_new(k) - u_old(k), 2);
+      norm += std::pow(u_new(k), 2);
+    }
+  return std::sqrt(diff / std::max(norm, 1e-300));
+}
+
+Eigen::VectorXd flatten(const Eigen::MatrixX2d& m) { return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()); }
+
+Eigen::MatrixX2d unflatten(const Eigen::VectorXd& v) {
+  return Eigen::Map<const Eigen::MatrixX2d>(v.data(), v.size() / 2, 2);
+}
+
+std::unique_ptr<detail::FlowElement> make_element(const std::string& name, FluidMesh mesh) {
+  if (name == "p1p1") return detail::make_p1p1_element(std::move(mesh));
+  if (name == "p2p1") return detail::make_p2p1_element(std::move(mesh));
+  throw std::invalid_argument("fluid element must be p1p1 or p2p1, got '" + name + "'");
+}
+
+}  // namespace
+
+struct FlowSolver::Impl {
+  std::unique_ptr<detail::FlowElement> element;
+  detail::DofLayout dof;
+  int local = 0;                     // unknowns per triangle
+  std::vector<int> element_dofs;     // per triangle its `local` unknowns
+  std::vector<int> scatter;          // per triangle local x local positions in valuePtr (column-major local)
+  Eigen::SparseMatrix<double> matrix, volume;  // the system (constraints applied); the volume terms (reactions)
+  Eigen::VectorXd rhs, rhs_volume;
+  std::unique_ptr<SparseLu> lu;
+  std::vector<DirichletCondition> dirichlet;
+  std::vector<SymmetryCondition> symmetry;
+  std::vector<detail::InterfaceEdge> edges;
+  int pressure_vertex = -1;
+  std::function<double(double)> pressure_value;
+  VelocityFunction body_force;
+  std::vector<std::vector<double>> thread_values;
+
+  const FluidMesh& mesh() const { return element->mesh(); }
+  const int* dofs_of(int e) const { return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)]; }
+  const int* scatter_of(int e) const {
+    return &scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local)];
+  }
+  // Adds a local system of triangle e to the matrix values and the right-hand side.
+  void add(int e, const detail::LocalSystem& s, double* values, Eigen::VectorXd& b) const {
+    const int* sc = scatter_of(e);
+    for (int j = 0; j < local; ++j)
+      for (int i = 0; i < local; ++i) values[sc[local * j + i]] += s.matrix(i, j);
+    const int* d = dofs_of(e);
+    for (int i = 0; i < local; ++i) b(d[i]) += s.rhs(i);
+  }
+  void build_pattern();
+  int assemble_volume(const detail::AssemblyInput& in, int threads, double& bad);
+};
+
+// Sparsity: per column the sorted rows coupled to it by some triangle; the CSC structure and
+// every triangle's positions in it.
+void FlowSolver::Impl::build_pattern() {
+  const int ndof = dof.dofs, ne = mesh().triangle_count();
+  local = element->local_size();
+  element_dofs.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local));
+  for (int e = 0; e < ne; ++e) element->element_dofs(e, &element_dofs[static_cast<std::size_t>(e * local)]);
+  std::vector<std::vector<int>> rows(static_cast<std::size_t>(ndof));
+  for (int e = 0; e < ne; ++e)
+    for (int i = 0; i < local; ++i)
+      for (int j = 0; j < local; ++j) rows[static_cast<std::size_t>(dofs_of(e)[i])].push_back(dofs_of(e)[j]);
+  std::size_t nnz = 0;
+  for (auto& list : rows) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    nnz += list.size();
+  }
+  matrix.resize(ndof, ndof);
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  int pos = 0;
+  for (int c = 0; c < ndof; ++c) {
+    matrix.outerIndexPtr()[c] = pos;
+    for (int r : rows[static_cast<std::size_t>(c)]) matrix.innerIndexPtr()[pos++] = r;
+  }
+  matrix.outerIndexPtr()[ndof] = pos;
+  std::fill(matrix.valuePtr(), matrix.valuePtr() + nnz, 0.0);
+  volume = matrix;
+  scatter.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local * local));
+  for (int e = 0; e < ne; ++e) {
+    const int* d = dofs_of(e);
+    for (int j = 0; j < local; ++j) {
+      const auto& list = rows[static_cast<std::size_t>(d[j])];
+      for (int i = 0; i < local; ++i) {
+        const auto it = std::lower_bound(list.begin(), list.end(), d[i]);
+        scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local) + static_cast<std::size_t>(local * j + i)] =
+            matrix.outerIndexPtr()[d[j]] + static_cast<int>(it - list.begin());
+      }
+    }
+  }
+}
+
+// The volume terms into `volume` and `rhs_volume` (threads: each its own copy of the values,
+// summed in thread order). Returns an inverted triangle (with its `bad` measure), or -1.
+int FlowSolver::Impl::assemble_volume(const detail::AssemblyInput& in, int nthreads, double& bad) {
+  const std::size_t nnz = static_cast<std::size_t>(matrix.nonZeros());
+  thread_values.resize(static_cast<std::size_t>(nthreads));
+  std::vector<Eigen::VectorXd> thread_rhs(static_cast<std::size_t>(nthreads), Eigen::VectorXd::Zero(dof.dofs));
+  int bad_element = -1;
+  const int ne = mesh().triangle_count();
+#pragma omp parallel num_threads(nthreads)
+  {
+#ifdef _OPENMP
+    const int tid = omp_get_thread_num();
+#else
+    const int tid = 0;
+#endif
+    auto& values = thread_values[static_cast<std::size_t>(tid)];
+    values.assign(nnz, 0.0);
+    auto& b = thread_rhs[static_cast<std::size_t>(tid)];
+    detail::LocalSystem s;
+#pragma omp for schedule(static)
+    for (int e = 0; e < ne; ++e) {
+      double measure = 0;
+      if (!element->assemble(e, in, s, measure)) {
+#pragma omp critical
+        {
+          bad_element = e;
+          bad = measure;
+        }
+        continue;
+      }
+      add(e, s, values.data(), b);
+    }
+  }
+  double* vv = volume.valuePtr();
+  std::copy(thread_values[0].begin(), thread_values[0].end(), vv);
+  rhs_volume = thread_rhs[0];
+  for (int t = 1; t < nthreads; ++t) {
+    const auto& tv = thread_values[static_cast<std::size_t>(t)];
+    for (std::size_t k = 0; k < nnz; ++k) vv[k] += tv[k];
+    rhs_volume += thread_rhs[static_cast<std::size_t>(t)];
+  }
+  return bad_element;
+}
+
+// Everything a solve of one time level fixes before its iterations.
+struct FlowSolver::Step {
+  double time = 0, dt = 0;       // dt: 0 if steady
+  double alpha0_dt = 0;          // alpha0 / dt (0 if steady)
+  Eigen::MatrixX2d mesh_velocity, body;
+  Eigen::VectorXd U_lin;         // linearisation velocity of the first iteration
+  Eigen::VectorXd history;       // (alpha1 u_n + alpha2 u_{n-1}) / dt
+  StrongConstraints constraints;
+  bool retrial = false;          // a repeated solve of the time level: start from its last solution
+};
+
+FlowSolver::FlowSolver(FluidMesh mesh, FlowParameters params, const std::string& element)
+    : params_(params), impl_(std::make_unique<Impl>()) {
+  auto& im = *impl_;
+  im.element = make_element(element, std::move(mesh));
+  im.dof = im.element->layout();
+  im.lu = std::make_unique<SparseLu>(params_);
+  im.build_pattern();
+  U_ = U_n_ = U_nm1_ = reaction_ = Eigen::VectorXd::Zero(im.dof.dofs);
+  X_ = X_n_ = X_nm1_ = im.mesh().nodes;
+  interface_segments_.resize(0, 2);
+}
+
+FlowSolver::~FlowSolver() = default;
+FlowSolver::FlowSolver(FlowSolver&&) noexcept = default;
+FlowSolver& FlowSolver::operator=(FlowSolver&&) noexcept = default;
+
+const FluidMesh& FlowSolver::mesh() const { return impl_->mesh(); }
+int FlowSolver::dofs() const { return impl_->dof.dofs; }
+const Eigen::SparseMatrix<double>& FlowSolver::last_matrix() const { return impl_->matrix; }
+const Eigen::VectorXd& FlowSolver::last_rhs() const { return impl_->rhs; }
+
+void FlowSolver::add_dirichlet(const std::string& group, VelocityFunction velocity) {
+  impl_->dirichlet.push_back({mesh().boundary_nodes({group}), std::move(velocity)});
+}
+
+void FlowSolver::add_symmetry(const std::string& group) {
+  impl_->symmetry.push_back({mesh().boundary_nodes({group}), symmetry_component(mesh(), group)});
+}
+
+void FlowSolver::set_interface(const std::vector<std::string>& groups) {
+  const auto& m = mesh();
+  interface_nodes_ = m.boundary_nodes(groups);
+  std::map<int, int> local;
+  for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
+  std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // vertex pair -> (triangle, edge)
+  for (int e = 0; e < m.triangle_count(); ++e)
+    for (int k = 0; k < 3; ++k) {
+      const int a = m.triangles(e, k), b = m.triangles(e, (k + 1) % 3);
+      edge_owner[{std::min(a, b), std::max(a, b)}] = {e, k};
+    }
+  impl_->edges.clear();
+  std::vector<std::array<int, 2>> segs;
+  for (const auto& name : groups) {
+    const auto& seg = m.boundary(name);
+    for (Eigen::Index s = 0; s < seg.rows(); ++s) {
+      const int a = seg(s, 0), b = seg(s, 1);
+      const auto it = edge_owner.find({std::min(a, b), std::max(a, b)});
+      if (it == edge_owner.end())
+        throw std::runtime_error(fmt::format("interface group '{}': segment ({}, {}) is not a triangle edge", name, a, b));
+      impl_->edges.push_back(impl_->element->interface_edge(it->second.first, it->second.second, a, b, local, segs));
+    }
+  }
+  interface_segments_.resize(static_cast<Eigen::Index>(segs.size()), 2);
+  for (std::size_t s = 0; s < segs.size(); ++s) interface_segments_.row(static_cast<Eigen::Index>(s)) << segs[s][0], segs[s][1];
+  interface_velocity_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
+}
+
+void FlowSolver::set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value) {
+  Eigen::Index best = 0;
+  (mesh().nodes.topRows(mesh().vertices()).rowwise() - point.transpose()).rowwise().squaredNorm().minCoeff(&best);
+  impl_->pressure_vertex = static_cast<int>(best);
+  impl_->pressure_value = std::move(value);
+}
+
+void FlowSolver::set_body_force(VelocityFunction force) { impl_->body_force = std::move(force); }
+
+void FlowSolver::set_initial_velocity(const Eigen::MatrixX2d& velocity) {
+  for (int i = 0; i < mesh().node_count(); ++i)
+    for (int c = 0; c < 2; ++c) {
+      const int k = impl_->dof.velocity(i, c);
+      U_n_(k) = U_nm1_(k) = U_(k) = velocity(i, c);
+    }
+}
+
+FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::MatrixX2d& positions,
+                                        const Eigen::VectorXd& interface_velocity) {
+  const auto& im = *impl_;
+  const int n = mesh().node_count();
+  if (positions.rows() != n) throw std::invalid_argument("FlowSolver::solve: positions has the wrong size");
+  X_ = positions;
+  dt_trial_ = dt;
+  if (interface_velocity.size() == 0) interface_velocity_.setZero();
+  else if (interface_velocity.size() != 2 * static_cast<Eigen::Index>(interface_nodes_.size()))
+    throw std::invalid_argument(fmt::format("interface velocity has {} entries, expected {}", interface_velocity.size(),
+                                            2 * interface_nodes_.size()));
+  else interface_velocity_ = interface_velocity;
+
+  Step s;
+  s.time = time;
+  // Time discretisation, and the mesh velocity BDF-consistent with it.
+  const bool steady = params_.scheme == TimeScheme::Steady;
+  const auto [alpha0, alpha1, alpha2, extrap] = bdf_coefficients(params_.scheme, accepted_, dt, dt_n_);
+  s.dt = steady ? 0.0 : dt;
+  s.alpha0_dt = steady ? 0.0 : alpha0 / dt;
+  s.mesh_velocity = Eigen::MatrixX2d::Zero(n, 2);
+  if (!steady) s.mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
+  s.U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
+  // A later coupling iteration of the step starts its linear solve from the last iterate's
+  // solution (closer than the extrapolation; the system solved is the same).
+  s.retrial = trial_solves_ > 0 && U_.size() == s.U_lin.size();
+  if (params_.relinearise && trial_solves_ > 0) s.U_lin = U_;  // a coupling iteration: about the last iterate
+  ++trial_solves_;
+  s.history = Eigen::VectorXd::Zero(im.dof.dofs);
+  if (!steady) s.history = (alpha1 * U_n_ + alpha2 * U_nm1_) / dt;
+
+  // Constraints at t_{n+1} on the current positions.
+  s.constraints = strong_constraints(im.dof, im.dirichlet, im.symmetry, X_, time,
+                                     im.pressure_vertex >= 0 ? im.dof.pressure(im.pressure_vertex) : -1,
+                                     im.pressure_value ? im.pressure_value(time) : 0.0);
+  s.body = Eigen::MatrixX2d::Zero(n, 2);
+  if (im.body_force)
+    for (int i = 0; i < n; ++i) s.body.row(i) = im.body_force(X_.row(i).transpose(), time).transpose();
+  return s;
+}
+
+// The system of one iteration about U_lin: volume terms, Nitsche terms, strong constraints.
+void FlowSolver::assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report) {
+  auto& im = *impl_;
+  const auto t_assembly = Clock::now();
+  const detail::AssemblyInput in{X_, step.mesh_velocity, step.body, U_lin, step.history, params_, step.alpha0_dt, step.dt};
+  im.element->prepare(in);
+  double bad = 0;
+  if (const int e = im.assemble_volume(in, std::max(1, params_.threads), bad); e >= 0) {
+    const auto& m = mesh();
+    const Eigen::RowVector2d centre = (X_.row(m.triangles(e, 0)) + X_.row(m.triangles(e, 1)) + X_.row(m.triangles(e, 2))) / 3.0;
+    throw SolverError(fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}) is {}; the mesh motion "
+                                  "tangled the mesh",
+                                  step.time, im.element->cell_name(), e, centre(0), centre(1), im.element->inverted(bad)));
+  }
+  std::copy(im.volume.valuePtr(), im.volume.valuePtr() + im.volume.nonZeros(), im.matrix.valuePtr());
+  im.rhs = im.rhs_volume;
+  // Nitsche terms on the interface.
+  const detail::NitscheInput nitsche{X_, X_n_, interface_velocity_, params_};
+  detail::LocalSystem s;
+  for (const auto& edge : im.edges) {
+    im.element->nitsche(edge, nitsche, s);
+    im.add(edge.element, s, im.matrix.valuePtr(), im.rhs);
+  }
+  apply_constraints(im.matrix, im.rhs, step.constraints);
+  report.assembly_seconds += seconds_since(t_assembly);
+}
+
+StepReport FlowSolver::solve(double time, double dt, const Eigen::MatrixX2d& positions,
+                             const Eigen::VectorXd& interface_velocity) {
+  StepReport report;
+  auto& im = *impl_;
+  Step step = begin_step(time, dt, positions, interface_velocity);
+  Eigen::VectorXd& U_lin = step.U_lin;
+  double previous_change = std::numeric_limits<double>::infinity();
+  for (int iteration = 1; iteration <= std::max(1, params_.max_iterations); ++iteration) {
+    assemble(step, U_lin, report);
+    Eigen::VectorXd U_new = im.lu->solve(im.matrix, im.rhs, step.retrial ? U_ : U_lin, report,
+                                         fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
+                                         step.alpha0_dt);
+    double change = relative_velocity_change(U_new, U_lin, mesh().node_count(), im.dof);
+    // Damped Newton (P2/P1): an update that grows the change is halved (iterations 3 on, so
+    // the first Oseen/Stokes solve and the first Newton correction are always taken whole).
+    if (im.element->damped_newton() && params_.newton && iteration >= 3 && change > previous_change) {
+      U_new = U_lin + 0.5 * (U_new - U_lin);
+      change *= 0.5;
+    }
+    previous_change = change;
+    report.change = change;
+    report.iterations = iteration;
+    U_ = U_new;
+    U_lin = U_new;
+    reaction_ = im.volume * U_ - im.rhs_volume;
+    if (report.change < params_.tolerance) break;
+  }
+  return report;
+}
+
+void FlowSolver::accept() {
+  U_nm1_ = U_n_;
+  U_n_ = U_;
+  X_nm1_ = X_n_;
+  X_n_ = X_;
+  dt_n_ = dt_trial_;
+  ++accepted_;
+  trial_solves_ = 0;
+}
+
+// Entries under `prefix`: element (text), u, u_n, u_nm1, reaction (every unknown), x, x_n,
+// x_nm1 (every node, column-major: all x then all y), dt_n, dt_trial, accepted_steps,
+// trial_solves, interface_velocity (2 per interface node); the linear solver's under "lu.".
+void FlowSolver::save_state(StateArchive& state, const std::string& prefix) {
+  state.put(prefix + "element", std::string(impl_->element->name()));
+  state.put(prefix + "u", U_);
+  state.put(prefix + "u_n", U_n_);
+  state.put(prefix + "u_nm1", U_nm1_);
+  state.put(prefix + "reaction", reaction_);
+  state.put(prefix + "x", flatten(X_));
+  state.put(prefix + "x_n", flatten(X_n_));
+  state.put(prefix + "x_nm1", flatten(X_nm1_));
+  state.put(prefix + "dt_n", dt_n_);
+  state.put(prefix + "dt_trial", dt_trial_);
+  state.put(prefix + "accepted_steps", static_cast<std::int64_t>(accepted_));
+  state.put(prefix + "trial_solves", static_cast<std::int64_t>(trial_solves_));
+  state.put(prefix + "interface_velocity", interface_velocity_);
+  impl_->lu->save_state(state, prefix + "lu.");
+  impl_->lu->discard_factors();  // the next solve refactorises, as in a solver restored from this state
+}
+
+// Reads every entry of the flow state before changing anything: a state that does not fit
+// (another element, mesh or interface) throws fsi::StateError naming the entry and leaves the
+// solver as it was; then the linear solver's entries.
+void FlowSolver::load_state(const StateArchive& state, const std::string& prefix) {
+  const std::string element = impl_->element->name(), saved = state.text(prefix + "element");
+  if (saved != element)
+    throw StateError(fmt::format("entry '{}element' is '{}', this configuration uses fluid.element {}", prefix, saved,
+                                 element));
+  const Eigen::Index ndof = U_.size(), npos = X_.size();
+  Eigen::VectorXd U = state.vector(prefix + "u", ndof), U_n = state.vector(prefix + "u_n", ndof),
+                  U_nm1 = state.vector(prefix + "u_nm1", ndof), reaction = state.vector(prefix + "reaction", ndof);
+  const Eigen::VectorXd X = state.vector(prefix + "x", npos), X_n = state.vector(prefix + "x_n", npos),
+                        X_nm1 = state.vector(prefix + "x_nm1", npos);
+  Eigen::VectorXd iface = state.vector(prefix + "interface_velocity", interface_velocity_.size());
+  const double dt_n = state.real(prefix + "dt_n"), dt_trial = state.real(prefix + "dt_trial");
+  const auto accepted = state.integer(prefix + "accepted_steps"), trial = state.integer(prefix + "trial_solves");
+  if (accepted < 0 || trial < 0)
+    throw StateError(fmt::format("entries '{}accepted_steps' / '{}trial_solves' are negative", prefix, prefix));
+  U_ = std::move(U);
+  U_n_ = std::move(U_n);
+  U_nm1_ = std::move(U_nm1);
+  reaction_ = std::move(reaction);
+  X_ = unflatten(X);
+  X_n_ = unflatten(X_n);
+  X_nm1_ = unflatten(X_nm1);
+  interface_velocity_ = std::move(iface);
+  dt_n_ = dt_n;
+  dt_trial_ = dt_trial;
+  accepted_ = static_cast<int>(accepted);
+  trial_solves_ = static_cast<int>(trial);
+  impl_->lu->load_state(state, prefix + "lu.");
+}
+
+Eigen::MatrixX2d FlowSolver::velocity() const {
+  Eigen::MatrixX2d v(mesh().node_count(), 2);
+  for (int i = 0; i < mesh().node_count(); ++i) v.row(i) << U_(impl_->dof.velocity(i, 0)), U_(impl_->dof.velocity(i, 1));
+  return v;
+}
+
+Eigen::VectorXd FlowSolver::pressure() const { return impl_->element->nodal_pressure(U_); }
+
+Eigen::Vector2d FlowSolver::force(const std::vector<std::string>& groups) const {
+  Eigen::Vector2d f = Eigen::Vector2d::Zero();
+  for (int node : mesh().boundary_nodes(groups)) f -= reaction_.segment<2>(impl_->dof.velocity(node, 0));
+  return f;
+}
+
+Eigen::SparseMatrix<double> FlowSolver::interface_mass() const {
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(9 * impl_->edges.size());
+  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
+  for (const auto& edge : impl_->edges) impl_->element->interface_mass(edge, X, t);
+  Eigen::SparseMatrix<double> m(n, n);
+  m.setFromTriplets(t.begin(), t.end());
+  return m;
+}
+
+Eigen::VectorXd FlowSolver::interface_velocity_integral() const {
+  Eigen::VectorXd vf(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
+  for (std::size_t i = 0; i < interface_nodes_.size(); ++i)
+    vf.segment<2>(2 * static_cast<Eigen::Index>(i)) = U_.segment<2>(impl_->dof.velocity(interface_nodes_[i], 0));
+  return apply_nodal(interface_mass(), vf);  // f_v = M_f v_f, the penalty term's own operator
+}
+
+Eigen::VectorXd FlowSolver::interface_traction() const {
+  const Eigen::Index ni = static_cast<Eigen::Index>(interface_nodes_.size());
+  Eigen::VectorXd f(2 * ni);
+  for (Eigen::Index i = 0; i < ni; ++i)
+    f.segment<2>(2 * i) = reaction_.segment<2>(impl_->dof.velocity(interface_nodes_[static_cast<std::size_t>(i)], 0));
+  // + gamma_N1 int N^T (v_f - v_s) = gamma_N1 (f_v - M_f v_s)
+  return f + params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));
+}
+
+// The vertex triangle holding `point` (at the positions of the last solve), with barycentric
+// coordinates; false when the point is outside (by more than round-off).
+bool FlowSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const {
+  const auto& m = mesh();
+  double best = -std::numeric_limits<double>::infinity();
+  for (int e = 0; e < m.triangle_count(); ++e) {
+    const Eigen::Vector2d a = X_.row(m.triangles(e, 0)), b = X_.row(m.triangles(e, 1)), c = X_.row(m.triangles(e, 2));
+    Eigen::Matrix2d J;
+    J << b - a, c - a;
+    const Eigen::Vector2d s = J.inverse() * (point - a);
+    const Eigen::Vector3d l(1 - s(0) - s(1), s(0), s(1));
+    const double worst = l.minCoeff();
+    if (worst > best) {
+      best = worst;
+      element = e;
+      bary = l;
+      if (worst >= 0) return true;
+    }
+  }
+  return best > -1e-9;
+}
+
+double FlowSolver::pressure_at(const Eigen::Vector2d& point) const {
+  int e = 0;
+  Eigen::Vector3d l;
+  if (!locate(point, e, l)) return std::numeric_limits<double>::quiet_NaN();
+  double p = 0;
+  for (int k = 0; k < 3; ++k) p += l(k) * U_(impl_->dof.pressure(mesh().triangles(e, k)));
+  return p;
+}
+
+Eigen::Vector2d FlowSolver::velocity_at(const Eigen::Vector2d& point) const {
+  int e = 0;
+  Eigen::Vector3d l;
+  if (!locate(point, e, l)) return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return impl_->element->velocity_at(e, l, U_);
+}
+
+}  // namespace fsi::fluid
