@@ -14,6 +14,7 @@
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
+#include "fsi/fluid/mesh_quality.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -554,6 +555,12 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
   probes["nonlinear_iterations"] = last_report_.iterations;
   probes["nonlinear_change"] = last_report_.change;
   probes["factorisations"] = factorisations_;
+  if (motion_) {  // the moving mesh's quality (fsi/fluid/mesh_quality.hpp)
+    const MeshQuality q = mesh_quality(solver_->mesh(), solver_->accepted_positions());
+    probes["mesh_min_scaled_jacobian"] = q.min_scaled_jacobian;
+    probes["mesh_max_angle"] = q.max_angle_deg;
+    if (solver_->mesh().quadratic()) probes["mesh_min_curved_jacobian"] = q.min_curved_jacobian;
+  }
 
   const auto now = std::chrono::steady_clock::now();
   if (std::chrono::duration<double>(now - last_log_).count() > 5.0 || info.time >= setup_.end_time - 1e-12) {
@@ -563,7 +570,7 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
     const double eta = done > 0 ? elapsed * (1 - done) / done : 0.0;
     std::string extra;
     for (const auto& [k, v] : probes)
-      if (k != "nonlinear_change" && k != "nonlinear_iterations" && k != "factorisations") extra += fmt::format(" {}={:.6g}", k, v);
+      if (k != "nonlinear_change" && k != "nonlinear_iterations" && k != "factorisations" && k.rfind("mesh_", 0) != 0) extra += fmt::format(" {}={:.6g}", k, v);
     // Debug only: the runner's progress line (step, time, iterations, ETA) is the one at info.
     fsi::logger("fluid")->debug("step {} t={:.4f}/{:.4g} ({:.0f}%) elapsed {:.1f}s ETA {:.1f}s |{}", info.step,
                                 info.time, setup_.end_time, 100 * done, elapsed, eta, extra);
