@@ -2,6 +2,8 @@
 
 #include <Eigen/LU>
 
+#include "fsi/fluid/p2p1_element.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -12,14 +14,12 @@ namespace fsi::fluid {
 
 namespace {
 
-// Quadratic shape functions (vertices, then the midpoints of edges 01, 12, 20) and their
-// reference derivatives.
+// The quadratic shape functions (p2p1_element.hpp) as plain arrays.
 void p2(double xi, double eta, double N[6], double dxi[6], double deta[6]) {
-  const double l0 = 1 - xi - eta;
-  const double n[6] = {l0 * (2 * l0 - 1), xi * (2 * xi - 1), eta * (2 * eta - 1), 4 * l0 * xi, 4 * xi * eta, 4 * eta * l0};
-  const double a[6] = {-(4 * l0 - 1), 4 * xi - 1, 0, 4 * (l0 - xi), 4 * eta, -4 * eta};
-  const double b[6] = {-(4 * l0 - 1), 0, 4 * eta - 1, -4 * xi, 4 * xi, 4 * (l0 - eta)};
-  std::copy(n, n + 6, N), std::copy(a, a + 6, dxi), std::copy(b, b + 6, deta);
+  Eigen::Matrix<double, 6, 1> n;
+  Eigen::Matrix<double, 6, 2> d;
+  p2_shape(xi, eta, n, d);
+  for (int k = 0; k < 6; ++k) N[k] = n(k), dxi[k] = d(k, 0), deta[k] = d(k, 1);
 }
 
 }  // namespace

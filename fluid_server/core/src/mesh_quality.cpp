@@ -1,5 +1,9 @@
 #include "fsi/fluid/mesh_quality.hpp"
 
+#include <Eigen/LU>
+
+#include "fsi/fluid/p2p1_element.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -36,14 +40,11 @@ double curved_jacobian(const Eigen::Matrix<double, 6, 2>& x) {
   constexpr int n = 4;
   for (int i = 0; i <= n; ++i)
     for (int j = 0; i + j <= n; ++j) {
-      const double xi = double(i) / n, eta = double(j) / n, l0 = 1 - xi - eta;
-      // d N / d xi and d N / d eta of the quadratic shape functions (vertices, then the
-      // midpoints of edges 01, 12, 20).
-      const double dxi[6] = {-(4 * l0 - 1), 4 * xi - 1, 0, 4 * (l0 - xi), 4 * eta, -4 * eta};
-      const double deta[6] = {-(4 * l0 - 1), 0, 4 * eta - 1, -4 * xi, 4 * xi, 4 * (l0 - eta)};
-      Eigen::RowVector2d a = Eigen::RowVector2d::Zero(), b = Eigen::RowVector2d::Zero();
-      for (int k = 0; k < 6; ++k) a += dxi[k] * x.row(k), b += deta[k] * x.row(k);
-      worst = std::min(worst, cross(a, b) / straight);
+      Eigen::Matrix<double, 6, 1> N;
+      Eigen::Matrix<double, 6, 2> dN;
+      p2_shape(double(i) / n, double(j) / n, N, dN);
+      const Eigen::Matrix2d J = x.transpose() * dN;  // columns d x / d xi, d x / d eta
+      worst = std::min(worst, J.determinant() / straight);
     }
   return worst;
 }
