@@ -5,8 +5,9 @@
 //    two edges at the corner, times 2 / sqrt(3); 1 for the equilateral triangle, 0 for a
 //    degenerate one, negative when the triangle is inverted;
 //  - the largest interior angle (degrees; 180 for a degenerate triangle);
-//  - for 6-node triangles, the curved-element Jacobian: min det J(xi) over a sampling lattice
-//    divided by the straight triangle's det J (1 for straight edges; <= 0: the element folds).
+//  - for 6-node triangles, the curved-element Jacobian: min det J(xi) at the points the solver
+//    checks (its quadrature points and the corners) divided by the straight triangle's det J
+//    (1 for straight edges; <= 0: the element folds).
 // Pure geometry: no solver, no I/O.
 #include <Eigen/Core>
 
