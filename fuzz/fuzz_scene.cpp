@@ -18,8 +18,14 @@
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/coupling/settings.hpp"
+#include "fsi/models/fluid_factory.hpp"
+#include "fsi/models/solid_factory.hpp"
 
 namespace {
+
+// The launcher's view: every section declared.
+const bool kDeclared = (fsi::coupling::coupling_section(), fsi::models::solid_section(), fsi::models::fluid_section(),
+                        true);
 
 template <class F>
 void expect_config_errors_only(const char* what, F&& f) {

@@ -37,8 +37,12 @@
 #include "fsi/common/run_report.hpp"
 #include "check.hpp"
 #include "fsi/common/scene_schema.hpp"
+#include "fsi/common/standalone.hpp"
 #include "fsi/common/version.hpp"
 #include "fsi/coupling/checkpoint.hpp"
+#include "fsi/coupling/settings.hpp"
+#include "fsi/models/fluid_factory.hpp"
+#include "fsi/models/solid_factory.hpp"
 
 namespace fs = std::filesystem;
 
@@ -505,7 +509,7 @@ int run_coupled(const RunOptions& o, const fsi::Scene& scene, const std::vector<
   try {
     if (!scene.has("solid") || !scene.has("fluid"))
       throw fsi::ConfigError(o.scene_path + ": a coupled scene needs 'solid' and 'fluid'");
-    const int every = scene.section("time").get<int>("checkpoint_every", 0);
+    const int every = fsi::read_time(scene).checkpoint_every;
     const int recover = o.recover < 0 ? (every > 0 ? 3 : 0) : o.recover;
     if (recover > 0 && every == 0)
       log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
@@ -684,6 +688,11 @@ int settle_run_options(RunOptions& o, bool run_parsed) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Every section's keys, each declared beside its reader: `fsi check`, `fsi run`'s check and
+  // the reference know them all.
+  fsi::coupling::coupling_section();
+  fsi::models::solid_section();
+  fsi::models::fluid_section();
   CLI::App app{"fsi: partitioned fluid-structure interaction co-simulation"};
   app.require_subcommand(1);
   app.set_version_flag("--version", fsi::version_line("fsi"));

@@ -204,6 +204,16 @@ bool ConfigSection::node_is_scalar(const std::string& key) const {
   return false;
 }
 
+bool ConfigSection::given(const std::string& key) const {
+  const YAML::Node value = lookup(key);
+  return value && !value.IsNull();
+}
+
+ConfigSection ConfigSection::child_or_empty(const std::string& key) const {
+  if (given(key)) return child(key);
+  return ConfigSection(state_, YAML::Node(YAML::NodeType::Map), full_key(key));
+}
+
 bool ConfigSection::has(const std::string& key) const {
   if (!node_.IsMap()) return false;
   for (const auto& kv : node_)

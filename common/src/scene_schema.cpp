@@ -1,4 +1,4 @@
-// Checks a scene against the schema (scene_schema_table.cpp) and writes the reference.
+// Checks a scene against the declared scene keys (scene_declare.cpp) and writes the reference.
 #include "fsi/common/scene_schema.hpp"
 
 #include <fmt/format.h>
@@ -61,6 +61,22 @@ std::string range_text(const Key& k) {
   if (k.hi) return fmt::format("{} {}", k.hi_open ? "<" : "<=", number_text(*k.hi));
   return "";
 }
+
+}  // namespace
+
+std::string range_problem(const Key& k, double value) {
+  if (!k.allowed.empty()) {
+    for (const auto& a : k.allowed)
+      if (std::stod(a) == value) return "";
+    return "must be " + join(k.allowed, " or ");
+  }
+  const bool low = k.lo && (k.lo_open ? !(value > *k.lo) : !(value >= *k.lo));
+  const bool high = k.hi && (k.hi_open ? !(value < *k.hi) : !(value <= *k.hi));
+  if (!low && !high) return "";
+  return k.range_message.empty() ? "must be " + range_text(k) : k.range_message;
+}
+
+namespace {
 
 const char* type_text(Type t) {
   switch (t) {
@@ -346,17 +362,8 @@ class Checker {
   }
 
   void check_range(const Key& k, double value, const YAML::Node& v, const std::string& key, const std::string& at) {
-    if (!k.allowed.empty()) {
-      for (const auto& a : k.allowed)
-        if (std::stod(a) == value) return;
-      add(at, key, fmt::format("'{}' must be {}, got '{}'", key, join(k.allowed, " or "), v.Scalar()));
-      return;
-    }
-    const bool low = k.lo && (k.lo_open ? !(value > *k.lo) : !(value >= *k.lo));
-    const bool high = k.hi && (k.hi_open ? !(value < *k.hi) : !(value <= *k.hi));
-    if (low || high)
-      add(at, key, fmt::format("'{}' {}, got '{}'", key,
-                               k.range_message.empty() ? "must be " + range_text(k) : k.range_message, v.Scalar()));
+    if (const auto problem = range_problem(k, value); !problem.empty())
+      add(at, key, fmt::format("'{}' {}, got '{}'", key, problem, v.Scalar()));
   }
 
   void check_value(const Key& k, const YAML::Node& v, const std::string& key, const std::string& at,
@@ -516,14 +523,10 @@ void cross_checks(const Scene& scene, const CheckOptions& options, CheckResult& 
       result.problems.push_back({"", e.what(), key});
     }
   };
-  if (clean("time")) as_problem("time", [&] { (void)read_time(scene); });  // end a whole number of steps
-  if (clean("coupling"))
-    as_problem("coupling", [&] {
-      const auto c = scene.section("coupling");
-      if (c.get<int>("algorithm") == 1 && !(c.get<double>("relaxation") < 2.0))
-        c.fail("relaxation", "(beta) must be in (0, 2) with Algorithm 1 (its stability limit 2 m_eff / (m_eff + "
-                             "m_a) is below 2)");
-    });
+  // Each section's rules between keys are its own reader's (time: end a whole number of steps;
+  // coupling: beta below 2 with Algorithm 1), run on the scene.
+  for (const auto& k : scene_keys())
+    if (k.check && clean(k.name)) as_problem(k.name, [&] { k.check(scene); });
 }
 
 }  // namespace
@@ -537,15 +540,15 @@ CheckResult check_scene(const Scene& scene, const CheckOptions& options) {
 }
 
 void require_valid(const Scene& scene, const std::vector<std::string>& sections) {
+  const std::vector<Key> declared = scene_keys();
   std::vector<std::string> known;
   for (const auto& s : sections)
-    if (std::any_of(scene_keys().begin(), scene_keys().end(), [&](const Key& k) { return k.name == s; }) &&
-        scene.has(s))
+    if (std::any_of(declared.begin(), declared.end(), [&](const Key& k) { return k.name == s; }) && scene.has(s))
       known.push_back(s);
   // A model the schema does not know (a test's, an external server's) is the factory's business.
   known.erase(std::remove_if(known.begin(), known.end(),
                              [&](const std::string& s) {
-                               const auto k = std::find_if(scene_keys().begin(), scene_keys().end(),
+                               const auto k = std::find_if(declared.begin(), declared.end(),
                                                            [&](const Key& x) { return x.name == s; });
                                if (k->selector.empty()) return false;
                                const YAML::Node model = find_key(find_key(scene.root_node(), s), k->selector);
@@ -638,9 +641,10 @@ void keys_with_nested(std::ostringstream& out, const std::vector<Key>& keys, con
 }  // namespace
 
 std::string reference_markdown() {
+  const std::vector<Key> keys = scene_keys();
   std::ostringstream out;
   out << "# Scene reference\n\n"
-      << "<!-- Generated from the scene schema (common/src/scene_schema_table.cpp) by\n"
+      << "<!-- Generated from the scene-key declarations (each component's *_keys.cpp) by\n"
       << "     `build/bin/fsi check --reference > docs/scene-reference.md`; do not edit by hand. -->\n\n"
       << "Every key a scene file (`configs/*.yaml`) may hold, per section and, for `solid` and\n"
       << "`fluid`, per `model`. `fsi check SCENE [--set key=value ...]` checks a scene against this\n"
@@ -655,14 +659,14 @@ std::string reference_markdown() {
   {
     std::vector<std::pair<std::string, const Key*>> nested;
     out << "| key | type | required | meaning |\n|---|---|---|---|\n";
-    for (const auto& k : scene_keys()) {
+    for (const auto& k : keys) {
       std::string meaning = k.meaning;
       if (k.name == "coupling") meaning += "; without it the scene has exactly one of `solid`, `fluid`";
       out << "| `" << k.name << "` | " << short_type(k.type) << " | " << (k.required ? "yes" : "") << " | "
           << escape(meaning) << " |\n";
     }
   }
-  for (const auto& k : scene_keys()) {
+  for (const auto& k : keys) {
     if (k.type != Type::Section) continue;
     if (k.selector.empty()) {
       out << "\n## " << k.name << "\n\n" << k.meaning << ".\n\n";

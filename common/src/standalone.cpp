@@ -10,6 +10,7 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/log_file.hpp"
 #include "fsi/common/run_report.hpp"
+#include "fsi/common/scene_reader.hpp"
 
 namespace fsi {
 namespace {
@@ -107,17 +108,44 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
 
 }  // namespace
 
+const schema::Key& time_section() {
+  using namespace schema;
+  static const Key time = [] {
+    Key k =
+      section("time", "time stepping (every runner)",
+              {
+                  number("dt", "time step").req().gt(0).in_unit("s"),
+                  number("end", "final time; a whole number of time steps").req().gt(0).in_unit("s"),
+                  integer("output_every", "VTK of both solvers (and the coupling interfaces) every N steps and at "
+                                          "t = 0; 0 = none")
+                      .def("0")
+                      .ge(0)
+                      .in_unit("steps"),
+                  integer("checkpoint_every", "coupled runs: a checkpoint of both solvers and the coupler every N "
+                                              "accepted steps; 0 = none")
+                      .def("0")
+                      .ge(0)
+                      .in_unit("steps"),
+                  integer("checkpoint_keep", "the newest K complete checkpoints are kept").def("2").ge(1),
+              })
+          .req();
+    k.check = [](const Scene& scene) { (void)read_time(scene); };  // end: a whole number of steps
+    return k;
+  }();
+  return time;
+}
+
 TimeSettings read_time(const Scene& scene) {
-  const auto t = scene.section("time");
+  const schema::Reader t(scene.section("time"), time_section());
   TimeSettings s;
   s.dt = t.get<double>("dt");
   s.end = t.get<double>("end");
-  s.output_every = t.get<int>("output_every", 0);
+  s.output_every = t.get<int>("output_every");
   if (!(s.dt > 0)) t.fail("dt", "must be positive");
   if (!(s.end > 0)) t.fail("end", "must be positive");
   if (s.output_every < 0) t.fail("output_every", "must be >= 0");
-  s.checkpoint_every = t.get<int>("checkpoint_every", 0);
-  s.checkpoint_keep = t.get<int>("checkpoint_keep", 2);
+  s.checkpoint_every = t.get<int>("checkpoint_every");
+  s.checkpoint_keep = t.get<int>("checkpoint_keep");
   if (s.checkpoint_every < 0) t.fail("checkpoint_every", "must be >= 0 (0 = no checkpoints)");
   if (s.checkpoint_keep < 1) t.fail("checkpoint_keep", "must be >= 1");
   s.steps = static_cast<int>(std::llround(s.end / s.dt));

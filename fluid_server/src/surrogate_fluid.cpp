@@ -1,19 +1,20 @@
 #include "fsi/models/surrogate_fluid.hpp"
 
+#include "fsi/common/scene_reader.hpp"
+
 namespace fsi::models {
 namespace {
-Eigen::Vector2d vector2(const ConfigSection& section, const std::string& key) {
-  const auto v = fsi::read_vector2(section, key);
+Eigen::Vector2d vector2(const schema::Reader& r, const std::string& key) {
+  const auto v = r.vector2(key);
   return {v[0], v[1]};
 }
 }  // namespace
 
-void SurrogateFluid::configure(const ConfigSection& s, const FluidSetup&) {
+void SurrogateFluid::configure(const ConfigSection& section, const FluidSetup&) {
+  const schema::Reader s(section, surrogate_fluid_keys());
   force_ = vector2(s, "force");
-  added_mass_ = s.get<double>("added_mass", 0.0);
-  measure_ = s.get<double>("interface_measure", 1.0);
-  if (added_mass_ < 0) s.fail("added_mass", "must be >= 0");
-  if (!(measure_ > 0)) s.fail("interface_measure", "must be positive");
+  added_mass_ = s.get<double>("added_mass");
+  measure_ = s.get<double>("interface_measure");
 }
 
 InterfaceMeshData SurrogateFluid::interface() const {

@@ -1,26 +1,25 @@
 #include "fsi/models/sdof_solid.hpp"
 
+#include "fsi/common/scene_reader.hpp"
+
 namespace fsi::models {
 namespace {
-Eigen::Vector2d vector2(const ConfigSection& section, const std::string& key) {
-  const auto v = fsi::read_vector2(section, key);
+Eigen::Vector2d vector2(const schema::Reader& r, const std::string& key) {
+  const auto v = r.vector2(key);
   return {v[0], v[1]};
 }
 }  // namespace
 
 
-void SdofSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
+void SdofSolid::configure(const ConfigSection& section, const SolidSetup& setup) {
+  const schema::Reader s(section, sdof_solid_keys());
   mass_ = s.get<double>("mass");
-  damping_ = s.get<double>("damping", 0.0);
-  stiffness_ = s.get<double>("stiffness", 0.0);
-  measure_ = s.get<double>("interface_measure", 1.0);
+  damping_ = s.get<double>("damping");
+  stiffness_ = s.get<double>("stiffness");
+  measure_ = s.get<double>("interface_measure");
   force_ = vector2(s, "force");
   d0_ = vector2(s, "initial_displacement");
   v0_ = vector2(s, "initial_velocity");
-  if (!(mass_ > 0)) s.fail("mass", "must be positive");
-  if (damping_ < 0) s.fail("damping", "must be >= 0");
-  if (stiffness_ < 0) s.fail("stiffness", "must be >= 0");
-  if (!(measure_ > 0)) s.fail("interface_measure", "must be positive");
   gamma_ = setup.interface_damping;
   interface_damping_ = gamma_ * measure_;  // M_fs = gamma_N1 * M_G (until the coupler gives its M_G)
   d_n_ = d_ = d0_;

@@ -194,7 +194,7 @@ def reference_current():
     with open(path, "rb") as f:
         current = f.read()
     if current != out.encode():
-        sys.exit("docs/scene-reference.md is not current with the scene schema (common/src/scene_schema_table.cpp); "
+        sys.exit("docs/scene-reference.md is not current with the scene-key declarations (the *_keys.cpp files); "
                  "regenerate it: build/bin/fsi check --reference > docs/scene-reference.md")
     print(f"docs/scene-reference.md current ({len(current)} bytes)")
 

@@ -244,10 +244,7 @@ TEST(Accelerator, AnotherSchemesCheckpointStartsAfresh) {
 }
 
 TEST(Registry, NamesAreTheSchemasChoices) {
-  const fsi::schema::Key* coupling = nullptr;
-  for (const auto& k : fsi::schema::scene_keys())
-    if (k.name == "coupling") coupling = &k;
-  ASSERT_NE(coupling, nullptr);
+  const fsi::schema::Key* coupling = &fsi::coupling::coupling_section();
   auto allowed = [&](const std::string& name) {
     for (const auto& k : coupling->children)
       if (k.name == name) return k.allowed;

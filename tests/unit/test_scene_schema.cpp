@@ -1,6 +1,7 @@
 // The scene schema: suggestions, problems with their places, the servers' pre-check.
 #include <gtest/gtest.h>
 
+#include "fsi/common/scene_reader.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/coupling/settings.hpp"
@@ -8,6 +9,10 @@
 #include "fsi/models/solid_factory.hpp"
 
 namespace {
+
+// The sections a program knows are the ones it declares (the launcher: all of them).
+const bool kDeclared = (fsi::coupling::coupling_section(), fsi::models::solid_section(), fsi::models::fluid_section(),
+                        true);
 
 std::vector<std::string> problems(const std::string& text, const std::vector<std::string>& overrides = {}) {
   std::vector<std::string> out;
@@ -153,3 +158,38 @@ TEST(SceneSchema, ReferenceListsEveryModel) {
 }
 
 }  // namespace
+
+// The C++ settings' initialisers (used when code builds settings itself, as the tests do) are
+// the scene's declared defaults: a scene that gives only the required keys reads the same.
+TEST(DeclaredOnce, CouplingSettingsInitialisersAreTheDeclaredDefaults) {
+  const auto scene = fsi::Scene::parse(
+      "time: {dt: 0.1, end: 1.0}\ncoupling: {algorithm: 1, gamma_n1: 0, relaxation: 1, iterations: {max: 1}}\n",
+      "s.yaml");
+  const auto read = fsi::coupling::read_coupling(scene.section("coupling"));
+  const fsi::coupling::CouplingSettings init;
+  EXPECT_EQ(read.nitsche_symmetry, init.nitsche_symmetry);
+  EXPECT_EQ(read.predictor, init.predictor);
+  EXPECT_EQ(read.acceleration, init.acceleration);
+  EXPECT_EQ(read.iqn_filter, init.iqn_filter);
+  EXPECT_EQ(read.iqn_filter_type, init.iqn_filter_type);
+  EXPECT_EQ(read.iqn_preconditioner, init.iqn_preconditioner);
+  EXPECT_EQ(read.imvj_restart, init.imvj_restart);
+  EXPECT_EQ(read.imvj_chunk_size, init.imvj_chunk_size);
+  EXPECT_EQ(read.imvj_restart_reuse_steps, init.imvj_restart_reuse_steps);
+  EXPECT_EQ(read.imvj_truncation, init.imvj_truncation);
+  EXPECT_EQ(read.tolerance, init.tolerance);
+  EXPECT_EQ(read.stop_if_not_converged, init.stop_if_not_converged);
+  EXPECT_EQ(read.divergence_factor, init.divergence_factor);
+  EXPECT_EQ(read.force_limit, init.force_limit);
+  EXPECT_EQ(read.robin_mass, init.robin_mass);
+  EXPECT_EQ(read.combine_all, init.combine_all);
+}
+
+// A reader that asks for a key its declaration lacks is a programming error, not a user's.
+TEST(DeclaredOnce, ReadingAnUndeclaredKeyIsALogicError) {
+  const auto scene = fsi::Scene::parse("time: {dt: 0.1, end: 1.0}\n", "s.yaml");
+  const fsi::schema::Reader r(scene.section("time"), fsi::time_section());
+  EXPECT_EQ(r.get<int>("checkpoint_keep"), 2);  // the declared default
+  EXPECT_THROW((void)r.get<int>("checkpoint_kept"), std::logic_error);
+  EXPECT_THROW((void)r.get_or<int>("checkpoint_keep", 3), std::logic_error);  // declared default: use get
+}

@@ -14,13 +14,14 @@
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
+#include "fsi/common/scene_reader.hpp"
 #include "fsi/fluid/mesh_quality.hpp"
 
 namespace fsi::fluid {
 namespace {
 
 // Directory of the scene file that holds `key` (from "file:line:col" or "file (--set)").
-std::filesystem::path scene_directory(const ConfigSection& section, const std::string& key) {
+std::filesystem::path scene_directory(const schema::Reader& section, const std::string& key) {
   std::string where = section.where(key);
   const std::string set_suffix = " (--set)";
   if (where.size() > set_suffix.size() && where.compare(where.size() - set_suffix.size(), set_suffix.size(), set_suffix) == 0)
@@ -32,7 +33,7 @@ std::filesystem::path scene_directory(const ConfigSection& section, const std::s
 
 // A path from the scene: absolute; else relative to the scene file; else to the working
 // directory; else to configs/ under the working directory.
-std::filesystem::path resolve_path(const ConfigSection& section, const std::string& key) {
+std::filesystem::path resolve_path(const schema::Reader& section, const std::string& key) {
   const std::filesystem::path given = section.get<std::string>(key);
   if (given.is_absolute()) {
     if (!std::filesystem::exists(given)) section.fail(key, "file '" + given.string() + "' does not exist");
@@ -47,13 +48,19 @@ std::filesystem::path resolve_path(const ConfigSection& section, const std::stri
   section.fail(key, "file '" + given.string() + "' not found (tried " + tried + ")");
 }
 
-std::vector<std::string> string_list(const ConfigSection& section, const std::string& key) {
-  return section.get<std::vector<std::string>>(key, std::vector<std::string>{});
+std::vector<std::string> string_list(const schema::Reader& section, const std::string& key) {
+  return section.get<std::vector<std::string>>(key);
 }
 
-Eigen::Vector2d vector2(const ConfigSection& section, const std::string& key) {
-  const auto v = section.get<std::vector<double>>(key);
-  if (v.size() != 2) section.fail(key, fmt::format("must be a list of 2 numbers, got {}", v.size()));
+Eigen::Vector2d vector2(const schema::Reader& section, const std::string& key) {
+  const auto v = section.vector2(key);
+  return {v[0], v[1]};
+}
+
+// A point of a map whose names the user chooses (pressure_probes: name: [x, y]).
+Eigen::Vector2d named_point(const ConfigSection& map, const std::string& name) {
+  const auto v = map.get<std::vector<double>>(name);
+  if (v.size() != 2) map.fail(name, fmt::format("must be a list of 2 numbers, got {}", v.size()));
   return {v[0], v[1]};
 }
 
@@ -69,7 +76,7 @@ std::string read_text(const std::filesystem::path& path) {
 // One place for every run, so a mesh is made once: $FSI_MESH_CACHE, else
 // $XDG_CACHE_HOME/fsi/meshes, else ~/.cache/fsi/meshes (entries keyed by a hash of the .geo
 // text, its parameters and the element order); fluid.mesh.cache_dir overrides it.
-std::filesystem::path mesh_cache(const ConfigSection& mesh_section) {
+std::filesystem::path mesh_cache(const schema::Reader& mesh_section) {
   std::filesystem::path cache;
   if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env) cache = env;
   else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) cache = std::filesystem::path(xdg) / "fsi" / "meshes";
@@ -81,20 +88,20 @@ std::filesystem::path mesh_cache(const ConfigSection& mesh_section) {
 
 // The .msh file: fluid.mesh.file, or fluid.mesh.geo meshed by gmsh (cached) with the size h,
 // the further parameters and the element order.
-std::filesystem::path mesh_file(const ConfigSection& mesh_section, int order) {
+std::filesystem::path mesh_file(const schema::Reader& mesh_section, int order) {
   if (mesh_section.has("file")) return resolve_path(mesh_section, "file");
   const auto geo = resolve_path(mesh_section, "geo");
   std::map<std::string, double> parameters;
   parameters["h"] = mesh_section.get<double>("size");
-  if (!(parameters["h"] > 0)) mesh_section.fail("size", "must be positive");
-  if (auto extra = mesh_section.optional_child("parameters"))
+  (void)mesh_section.declared("parameters");
+  if (auto extra = mesh_section.section().optional_child("parameters"))
     for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
   return mesh_geo(geo, parameters, mesh_cache(mesh_section), order);
 }
 
 // The mesh of `msh` in the element's order (P2/P1: a linear mesh gets straight midpoints).
-FluidMesh read_mesh(const ConfigSection& mesh_section, const std::filesystem::path& msh, bool taylor_hood) {
-  const auto domain = string_list(mesh_section, "domain");
+FluidMesh read_mesh(const schema::Reader& mesh_section, const std::filesystem::path& msh, bool taylor_hood) {
+  const auto domain = mesh_section.get_or<std::vector<std::string>>("domain", {});
   FluidMesh mesh;
   try {
     mesh = FluidMesh::from_gmsh(read_gmsh(msh), domain);
@@ -121,33 +128,27 @@ FluidMesh read_mesh(const ConfigSection& mesh_section, const std::filesystem::pa
 // --- physics and numerics ---
 
 // density, viscosity, scheme, nonlinear.
-void read_physics(const ConfigSection& section, bool taylor_hood, FlowParameters& params) {
+void read_physics(const schema::Reader& section, bool taylor_hood, FlowParameters& params) {
   params.density = section.get<double>("density");
   params.viscosity = section.get<double>("viscosity");
-  if (!(params.density > 0)) section.fail("density", "must be positive");
-  if (!(params.viscosity > 0)) section.fail("viscosity", "must be positive");
-  const auto scheme = section.get<std::string>("scheme", "bdf2");
-  if (scheme == "bdf1") params.scheme = TimeScheme::BDF1;
-  else if (scheme == "bdf2") params.scheme = TimeScheme::BDF2;
-  else if (scheme == "steady") params.scheme = TimeScheme::Steady;
-  else section.fail("scheme", "must be bdf1, bdf2 or steady, got '" + scheme + "'");
+  const auto scheme = section.get<std::string>("scheme");
+  params.scheme = scheme == "bdf1" ? TimeScheme::BDF1 : scheme == "steady" ? TimeScheme::Steady : TimeScheme::BDF2;
   // Steady Taylor-Hood problems default to Newton (P1/P1: Picard, as validated; newton on request:
   // the Galerkin Jacobian with Picard stabilisation terms, so it converges fast but not quadratically).
   std::string method = taylor_hood && params.scheme == TimeScheme::Steady ? "newton" : "picard";
-  if (auto nl = section.optional_child("nonlinear")) {
-    params.max_iterations = nl->get<int>("max_iterations", params.max_iterations);
-    params.tolerance = nl->get<double>("tolerance", params.tolerance);
-    if (params.max_iterations < 1) nl->fail("max_iterations", "must be at least 1");
-    params.relinearise = nl->get<bool>("relinearise", params.relinearise);
-    method = nl->get<std::string>("method", method);
-    if (method != "picard" && method != "newton") nl->fail("method", "must be picard or newton, got '" + method + "'");
+  {
+    const auto nl = section.child_or_defaults("nonlinear");
+    params.max_iterations = nl.get<int>("max_iterations");
+    params.tolerance = nl.get<double>("tolerance");
+    params.relinearise = nl.get<bool>("relinearise");
+    method = nl.get_or<std::string>("method", method);
   }
   params.newton = method == "newton";
   if (params.scheme == TimeScheme::Steady && params.max_iterations == 1) params.max_iterations = 50;
 }
 
 // fluid.stabilisation: each element's own keys (the other element's are refused).
-void read_stabilisation(const ConfigSection& section, bool taylor_hood, StabilisationParameters& s) {
+void read_stabilisation(const schema::Reader& section, bool taylor_hood, StabilisationParameters& s) {
   if (taylor_hood) {
     // Taylor-Hood is inf-sup stable: no PSPG; SUPG and grad-div only when asked for.
     s.supg = false;
@@ -156,59 +157,53 @@ void read_stabilisation(const ConfigSection& section, bool taylor_hood, Stabilis
   }
   const auto st = section.optional_child("stabilisation");
   if (!st) return;
-  s.supg = st->get<bool>("supg", s.supg);
-  s.viscous_constant = st->get<double>("viscous_constant", s.viscous_constant);
-  s.transient_tau = st->get<bool>("transient_tau", s.transient_tau);
+  s.supg = st->get_or<bool>("supg", s.supg);
+  s.viscous_constant = st->get<double>("viscous_constant");
+  s.transient_tau = st->get<bool>("transient_tau");
   if (taylor_hood) {
     for (const char* key : {"pspg", "lsic_scale", "viscous_residual"})
       if (st->has(key))
         st->fail(key, "is a P1/P1 setting; the P2/P1 element takes supg, grad_div, viscous_constant, transient_tau");
-    s.grad_div = st->get<double>("grad_div", s.grad_div);
-    if (s.grad_div < 0) st->fail("grad_div", "must be >= 0");
+    s.grad_div = st->get<double>("grad_div");
   } else {
     if (st->has("grad_div")) st->fail("grad_div", "is a P2/P1 setting; the P1/P1 element takes lsic_scale");
-    s.pspg = st->get<bool>("pspg", s.pspg);
-    s.lsic_scale = st->get<double>("lsic_scale", s.lsic_scale);
-    s.viscous_residual = st->get<bool>("viscous_residual", s.viscous_residual);
+    s.pspg = st->get<bool>("pspg");
+    s.lsic_scale = st->get<double>("lsic_scale");
+    s.viscous_residual = st->get<bool>("viscous_residual");
   }
 }
 
 // threads, umfpack_irstep, linear_solver.
-void read_linear_solver(const ConfigSection& section, bool taylor_hood, FlowParameters& params) {
-  params.threads = section.get<int>("threads", params.threads);
-  params.umfpack_irstep = section.get<int>("umfpack_irstep", params.umfpack_irstep);
-  if (params.umfpack_irstep < 0 || params.umfpack_irstep > 2) section.fail("umfpack_irstep", "must be 0, 1 or 2");
+void read_linear_solver(const schema::Reader& section, bool taylor_hood, FlowParameters& params) {
+  params.threads = section.get<int>("threads");
+  params.umfpack_irstep = section.get<int>("umfpack_irstep");
   if (taylor_hood) params.strategy = LuStrategy::Symmetric;
   const auto ls = section.optional_child("linear_solver");
   if (!ls) return;
-  const auto ordering = ls->get<std::string>("ordering", "auto");
-  if (ordering == "metis") params.ordering = Ordering::Metis;
-  else if (ordering == "amd") params.ordering = Ordering::Amd;
-  else if (ordering == "auto") params.ordering = Ordering::Auto;
-  else ls->fail("ordering", "must be auto, metis or amd, got '" + ordering + "'");
-  const auto strategy = ls->get<std::string>("strategy", taylor_hood ? "symmetric" : "auto");
-  if (strategy == "symmetric") params.strategy = LuStrategy::Symmetric;
-  else if (strategy == "unsymmetric") params.strategy = LuStrategy::Unsymmetric;
-  else if (strategy == "auto") params.strategy = LuStrategy::Auto;
-  else ls->fail("strategy", "must be auto, symmetric or unsymmetric, got '" + strategy + "'");
-  params.reuse_factorisation = ls->get<bool>("reuse_factorisation", params.reuse_factorisation);
-  params.krylov_tolerance = ls->get<double>("krylov_tolerance", params.krylov_tolerance);
-  params.krylov_max_iterations = ls->get<int>("krylov_max_iterations", params.krylov_max_iterations);
-  params.krylov_refactor_iterations = ls->get<int>("krylov_refactor_iterations", params.krylov_refactor_iterations);
-  params.adaptive_refactorisation = ls->get<bool>("adaptive_refactorisation", params.adaptive_refactorisation);
+  const auto ordering = ls->get<std::string>("ordering");
+  params.ordering = ordering == "metis" ? Ordering::Metis : ordering == "amd" ? Ordering::Amd : Ordering::Auto;
+  const auto strategy = ls->get_or<std::string>("strategy", taylor_hood ? "symmetric" : "auto");
+  params.strategy = strategy == "symmetric"     ? LuStrategy::Symmetric
+                    : strategy == "unsymmetric" ? LuStrategy::Unsymmetric
+                                                : LuStrategy::Auto;
+  params.reuse_factorisation = ls->get<bool>("reuse_factorisation");
+  params.krylov_tolerance = ls->get<double>("krylov_tolerance");
+  params.krylov_max_iterations = ls->get<int>("krylov_max_iterations");
+  params.krylov_refactor_iterations = ls->get<int>("krylov_refactor_iterations");
+  params.adaptive_refactorisation = ls->get<bool>("adaptive_refactorisation");
 }
 
 // Nitsche parameters: the coupler's gamma_N1 / gamma_N2 (setup); the scene's
 // interface.penalty / interface.symmetry are used when the setup gives no penalty
 // (standalone runs). Returns fluid.interface.groups.
-std::vector<std::string> read_nitsche(const ConfigSection& section, const FluidSetup& setup, FlowParameters& params) {
+std::vector<std::string> read_nitsche(const schema::Reader& section, const FluidSetup& setup, FlowParameters& params) {
   params.nitsche_penalty = setup.nitsche_penalty;
   params.nitsche_symmetry = setup.nitsche_symmetry;
   const auto iface = section.optional_child("interface");
   if (!iface) return {};
   auto groups = string_list(*iface, "groups");
-  const double penalty = iface->get<double>("penalty", setup.nitsche_penalty);
-  const double symmetry = iface->get<double>("symmetry", setup.nitsche_symmetry);
+  const double penalty = iface->get_or<double>("penalty", setup.nitsche_penalty);
+  const double symmetry = iface->get_or<double>("symmetry", setup.nitsche_symmetry);
   if (setup.nitsche_penalty == 0) {
     params.nitsche_penalty = penalty;
     params.nitsche_symmetry = symmetry;
@@ -218,11 +213,7 @@ std::vector<std::string> read_nitsche(const ConfigSection& section, const FluidS
                                setup.nitsche_symmetry);
   }
   if (params.nitsche_penalty < 0) iface->fail("penalty", "gamma_N1 must be >= 0");
-  const auto geometry = iface->get<std::string>("penalty_geometry", "current");
-  if (geometry == "step_start") params.penalty_on_step_start = true;
-  else if (geometry != "current")
-    iface->fail("penalty_geometry", "must be 'current' (the interface of this solve) or 'step_start' (of the last "
-                                    "accepted step), got '" + geometry + "'");
+  params.penalty_on_step_start = iface->get<std::string>("penalty_geometry") == "step_start";
   if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
   return groups;
 }
@@ -235,14 +226,14 @@ const char* scheme_name(TimeScheme scheme) {
 
 // The velocity of an inflow entry on `group`: a parabolic or uniform profile along the
 // group's extent (or profile_extent), optionally ramped and pulsating.
-VelocityFunction inflow_velocity(const ConfigSection& inflow, const FluidMesh& mesh, const std::string& group) {
-  const auto profile = inflow.get<std::string>("profile", "parabolic");
+VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& mesh, const std::string& group) {
+  const auto profile = inflow.get<std::string>("profile");
   double umax = 0;
   if (inflow.has("max_velocity")) umax = inflow.get<double>("max_velocity");
   else if (inflow.has("mean_velocity")) umax = (profile == "parabolic" ? 1.5 : 1.0) * inflow.get<double>("mean_velocity");
   else inflow.fail("max_velocity", "give max_velocity or mean_velocity");
-  const Eigen::Vector2d direction = inflow.has("direction") ? vector2(inflow, "direction").normalized() : Eigen::Vector2d(1, 0);
-  const double ramp = inflow.get<double>("ramp_time", 0.0);
+  const Eigen::Vector2d direction = vector2(inflow, "direction").normalized();
+  const double ramp = inflow.get<double>("ramp_time");
   // Extent of the inlet along its tangent.
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = Eigen::Vector2d::Constant(-1e300);
   for (int i : mesh.boundary_nodes({group})) {
@@ -264,14 +255,13 @@ VelocityFunction inflow_velocity(const ConfigSection& inflow, const FluidMesh& m
   // pulsation: {mean, amplitude, frequency} multiplies the profile by mean + amplitude sin(2 pi f t).
   double pulse_mean = 1.0, pulse_amplitude = 0.0, pulse_frequency = 0.0;
   if (auto pulse = inflow.optional_child("pulsation")) {
-    pulse_mean = pulse->get<double>("mean", 1.0);
+    pulse_mean = pulse->get<double>("mean");
     pulse_amplitude = pulse->get<double>("amplitude");
     pulse_frequency = pulse->get<double>("frequency");
   }
   std::function<double(double)> shape;
   if (profile == "parabolic") shape = [](double s) { return 4 * s * (1 - s); };
-  else if (profile == "uniform") shape = [](double) { return 1.0; };
-  else inflow.fail("profile", "must be parabolic or uniform, got '" + profile + "'");
+  else shape = [](double) { return 1.0; };
   return [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
     const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
     const double factor = ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
@@ -312,10 +302,10 @@ std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<
 NavierStokesFluid::NavierStokesFluid() = default;
 NavierStokesFluid::~NavierStokesFluid() = default;
 
-void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup& setup) {
+void NavierStokesFluid::configure(const ConfigSection& fluid_section, const FluidSetup& setup) {
+  const schema::Reader section(fluid_section, navier_stokes_keys());
   setup_ = setup;
-  element_ = section.get<std::string>("element", "p1p1");
-  if (element_ != "p1p1" && element_ != "p2p1") section.fail("element", "must be p1p1 or p2p1, got '" + element_ + "'");
+  element_ = section.get<std::string>("element");
   const bool taylor_hood = element_ == "p2p1";
   const auto mesh_section = section.child("mesh");
   const auto msh = mesh_file(mesh_section, taylor_hood ? 2 : 1);
@@ -345,7 +335,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
 
 // fluid.inflow, walls, moving_walls, symmetry, outlet and pressure_reference on the solver.
 // Returns the groups with a condition (the mesh motion holds them fixed).
-std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const ConfigSection& section, const std::string& msh) {
+std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema::Reader& section, const std::string& msh) {
   auto& solver = *solver_;
   const auto& mesh = solver.mesh();
   std::vector<std::string> fixed;
@@ -377,13 +367,13 @@ std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const Config
     fixed.push_back(g);
   }
   if (auto pr = section.optional_child("pressure_reference"))
-    solver.set_pressure_reference(vector2(*pr, "point"), [v = pr->get<double>("value", 0.0)](double) { return v; });
+    solver.set_pressure_reference(vector2(*pr, "point"), [v = pr->get<double>("value")](double) { return v; });
   return fixed;
 }
 
 // The Nitsche interface and the mesh motion (fluid.interface): the extension of the interface
 // displacement into the mesh, the groups with conditions held fixed.
-void NavierStokesFluid::configure_mesh_motion(const ConfigSection& section, const std::vector<std::string>& groups,
+void NavierStokesFluid::configure_mesh_motion(const schema::Reader& section, const std::vector<std::string>& groups,
                                               const std::vector<std::string>& fixed_groups) {
   const auto& fluid_mesh = solver_->mesh();
   const auto iface = section.child("interface");
@@ -391,18 +381,14 @@ void NavierStokesFluid::configure_mesh_motion(const ConfigSection& section, cons
     if (!fluid_mesh.has_boundary(g)) iface.fail("groups", "no boundary group '" + g + "'");
   solver_->set_interface(groups);
   MeshMotionOptions motion;
-  motion.stiffening = iface.get<double>("mesh_stiffening", 1.0);
-  const auto method = iface.get<std::string>("mesh_motion", "harmonic");
-  if (method == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
-  else if (method != "harmonic") iface.fail("mesh_motion", "must be 'harmonic' or 'elastic'");
-  motion.incremental = iface.get<bool>("mesh_incremental", false);
+  motion.stiffening = iface.get<double>("mesh_stiffening");
+  if (iface.get<std::string>("mesh_motion") == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
+  motion.incremental = iface.get<bool>("mesh_incremental");
   // P2 meshes: the interface midpoints take the solid's displacement (curved interface
   // edges follow the solid); the extension runs either on the vertices (default: interior
   // midpoints move with the mean of their edge's vertices, edges stay straight inside) or on
   // the 4-triangle refinement of every element (every node extended; 4x the unknowns).
-  const auto on = fluid_mesh.quadratic() ? iface.get<std::string>("mesh_motion_nodes", "vertices") : "all";
-  if (fluid_mesh.quadratic() && on != "vertices" && on != "all")
-    iface.fail("mesh_motion_nodes", "must be 'vertices' or 'all', got '" + on + "'");
+  const auto on = fluid_mesh.quadratic() ? iface.get<std::string>("mesh_motion_nodes") : "all";
   motion_on_vertices_ = fluid_mesh.quadratic() && on == "vertices";
   std::vector<int> moving = solver_->interface_nodes(), fixed = fluid_mesh.boundary_nodes(fixed_groups);
   if (motion_on_vertices_) {
@@ -427,11 +413,11 @@ void NavierStokesFluid::configure_mesh_motion(const ConfigSection& section, cons
 
 // Force probes, pressure probes and differences, VTK (fluid.forces, pressure_probes,
 // pressure_differences, output).
-void NavierStokesFluid::configure_output(const ConfigSection& section, double density) {
+void NavierStokesFluid::configure_output(const schema::Reader& section, double density) {
   const auto& fluid_mesh = solver_->mesh();
   for (const auto& f : section.list("forces")) {
     ForceProbe probe;
-    probe.name = f.get<std::string>("name", "");
+    probe.name = f.get<std::string>("name");
     probe.groups = f.get<std::vector<std::string>>("groups");
     for (const auto& g : probe.groups)
       if (!fluid_mesh.has_boundary(g)) f.fail("groups", "no boundary group '" + g + "'");
@@ -441,9 +427,11 @@ void NavierStokesFluid::configure_output(const ConfigSection& section, double de
     }
     forces_.push_back(probe);
   }
-  if (auto pp = section.optional_child("pressure_probes"))
-    for (const auto& k : pp->keys()) pressure_probes_.push_back({k, vector2(*pp, k)});
-  if (auto pd = section.optional_child("pressure_differences"))
+  (void)section.declared("pressure_probes");
+  (void)section.declared("pressure_differences");
+  if (auto pp = section.section().optional_child("pressure_probes"))
+    for (const auto& k : pp->keys()) pressure_probes_.push_back({k, named_point(*pp, k)});
+  if (auto pd = section.section().optional_child("pressure_differences"))
     for (const auto& k : pd->keys()) {
       const auto pair = pd->get<std::vector<std::string>>(k);
       if (pair.size() != 2) pd->fail(k, "must name two pressure probes [high, low]");
@@ -455,8 +443,7 @@ void NavierStokesFluid::configure_output(const ConfigSection& section, double de
   // VTK whenever the run asks (time.output_every), unless output.vtk_every says otherwise:
   // N > 0 = only at steps that are multiples of N, 0 = never.
   if (auto out = section.optional_child("output")) {
-    vtk_every_ = out->get<int>("vtk_every", -1);
-    if (vtk_every_ < 0 && out->has("vtk_every")) out->fail("vtk_every", "must be >= 0 (0 = never)");
+    vtk_every_ = out->get_or<int>("vtk_every", -1);
   }
   if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid");
 }

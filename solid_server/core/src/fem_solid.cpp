@@ -7,6 +7,7 @@
 #include <set>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/scene_reader.hpp"
 #include "fsi/solid/element.hpp"
 
 #ifdef FSI_HAVE_GMSH_READER
@@ -17,28 +18,13 @@ namespace fsi::solid {
 
 namespace {
 
-// A key that is either one name or a list of names.
-std::vector<std::string> names(const ConfigSection& s, const std::string& key) {
-  if (!s.has(key)) return {};
-  try {
-    return {s.get<std::string>(key)};
-  } catch (const ConfigError&) {
-    return s.get<std::vector<std::string>>(key);
-  }
-}
-
-Eigen::Vector2d vec2(const ConfigSection& s, const std::string& key, std::optional<Eigen::Vector2d> fallback = {}) {
-  if (!s.has(key) && fallback) {
-    s.get<std::string>(key, "");  // mark as read
-    return *fallback;
-  }
-  const auto v = s.get<std::vector<double>>(key);
-  if (v.size() != 2) s.fail(key, "must be a list of 2 numbers");
+Eigen::Vector2d vec2(const schema::Reader& s, const std::string& key) {
+  const auto v = s.vector2(key);
   return {v[0], v[1]};
 }
 
 // A file named in the scene: relative paths are relative to the scene file's folder.
-std::filesystem::path scene_path(const ConfigSection& s, const std::string& key) {
+std::filesystem::path scene_path(const schema::Reader& s, const std::string& key) {
   std::filesystem::path p = s.get<std::string>(key);
   if (p.is_absolute()) return p;
   std::string where = s.where(key);  // "file:line:col"
@@ -50,7 +36,7 @@ std::filesystem::path scene_path(const ConfigSection& s, const std::string& key)
   return std::filesystem::exists(candidate) ? candidate : p;
 }
 
-SolidMesh build_mesh(const ConfigSection& m) {
+SolidMesh build_mesh(const schema::Reader& m) {
   const auto type = m.get<std::string>("type");
   if (type == "rectangle") {
     const Eigen::Vector2d origin = vec2(m, "origin");
@@ -62,7 +48,7 @@ SolidMesh build_mesh(const ConfigSection& m) {
   }
   if (type == "gmsh") {
     const auto file = scene_path(m, "file");
-    const auto domain = m.get<std::string>("domain", "");
+    const auto domain = m.get_or<std::string>("domain", "");
 #ifdef FSI_HAVE_GMSH_READER
     try {
       return mesh_from_gmsh(fsi::read_gmsh(file), domain);
@@ -78,7 +64,8 @@ SolidMesh build_mesh(const ConfigSection& m) {
 
 }  // namespace
 
-void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
+void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) {
+  const schema::Reader s(section, fem_solid_keys());
   auto log = fsi::logger("solid");
   setup_ = setup;
 
@@ -89,17 +76,14 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   const auto mat = s.child("material");
   const auto law = mat.get<std::string>("law");
   const double nu = mat.get<double>("poisson_ratio");
-  if (!(nu > -1 && nu < 0.5)) mat.fail("poisson_ratio", "must be in (-1, 0.5)");
   ElasticConstants constants;
   const bool has_E = mat.has("youngs_modulus"), has_mu = mat.has("shear_modulus");
   if (has_E == has_mu) mat.fail(has_E ? "youngs_modulus" : "law", "give exactly one of youngs_modulus or shear_modulus");
   if (has_E) {
-    const double E = mat.get<double>("youngs_modulus");
-    if (!(E > 0)) mat.fail("youngs_modulus", "must be positive");
+    const double E = mat.get_or<double>("youngs_modulus", 0.0);
     constants = ElasticConstants::from_youngs(E, nu);
   } else {
-    const double mu = mat.get<double>("shear_modulus");
-    if (!(mu > 0)) mat.fail("shear_modulus", "must be positive");
+    const double mu = mat.get_or<double>("shear_modulus", 0.0);
     constants = ElasticConstants::from_shear(mu, nu);
   }
   std::shared_ptr<const Material> material;
@@ -109,11 +93,10 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
     mat.fail("law", e.what());
   }
   const double density = s.get<double>("density");
-  if (!(density > 0)) s.fail("density", "must be positive");
 
   // 3. Analysis type and scheme.
-  const auto analysis = s.get<std::string>("analysis", "dynamic");
-  const auto scheme = s.get<std::string>("time_scheme", "newmark");
+  const auto analysis = s.get<std::string>("analysis");
+  const auto scheme = s.get<std::string>("time_scheme");
   if (analysis == "static") {
     scheme_ = TimeScheme::Static;
   } else if (analysis == "dynamic") {
@@ -124,25 +107,22 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   } else {
     s.fail("analysis", "must be 'static' or 'dynamic', got '" + analysis + "'");
   }
-  load_steps_ = s.get<int>("load_steps", 1);
-  if (load_steps_ < 1) s.fail("load_steps", "must be >= 1");
+  load_steps_ = s.get<int>("load_steps");
 
   // 4. Newton and the linear solver.
-  if (auto n = s.optional_child("newton")) {
-    newton_.max_iterations = n->get<int>("max_iterations", newton_.max_iterations);
-    newton_.residual_tolerance = n->get<double>("residual_tolerance", newton_.residual_tolerance);
-    newton_.increment_tolerance = n->get<double>("increment_tolerance", newton_.increment_tolerance);
-    if (newton_.max_iterations < 1) n->fail("max_iterations", "must be >= 1");
-    if (!(newton_.residual_tolerance > 0)) n->fail("residual_tolerance", "must be positive");
-    if (!(newton_.increment_tolerance >= 0)) n->fail("increment_tolerance", "must be >= 0");
+  {
+    const auto n = s.child_or_defaults("newton");
+    newton_.max_iterations = n.get<int>("max_iterations");
+    newton_.residual_tolerance = n.get<double>("residual_tolerance");
+    newton_.increment_tolerance = n.get<double>("increment_tolerance");
   }
-  const auto solver_name = s.get<std::string>("linear_solver", "cholmod");
+  const auto solver_name = s.get<std::string>("linear_solver");
   LinearSolverKind solver_kind = LinearSolverKind::Cholmod;
   if (solver_name == "umfpack") solver_kind = LinearSolverKind::Umfpack;
   else if (solver_name != "cholmod") s.fail("linear_solver", "must be 'cholmod' or 'umfpack'");
 
   // 5. Clamps (homogeneous Dirichlet on named edges, both components).
-  const auto clamp = names(s, "clamp");
+  const auto clamp = s.names("clamp");
   std::vector<char> fixed(2 * mesh_.num_nodes(), 0);
   try {
     for (int n : mesh_.edge_nodes(clamp)) fixed[2 * n] = fixed[2 * n + 1] = 1;
@@ -150,15 +130,15 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
     s.fail("clamp", e.what());
   }
   system_ = std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind);
-  const auto element = s.get<std::string>("element", "q4");
+  const auto element = s.get<std::string>("element");
   if (element == "q4_eas") system_->set_element(ElementKind::Q4Eas);
   else if (element != "q4") s.fail("element", "must be 'q4' (bilinear) or 'q4_eas' (enhanced assumed strain), got '" + element + "'");
 
   // 6. Loads: gravity (force per reference volume rho_s g), dead edge tractions, point loads.
-  const Eigen::Vector2d gravity = vec2(s, "gravity", Eigen::Vector2d::Zero());
+  const Eigen::Vector2d gravity = vec2(s, "gravity");
   dead_load_ = system_->body_force(Eigen::Vector2d(density * gravity));
   for (const auto& t : s.list("tractions")) {
-    const auto boundary = names(t, "boundary");
+    const auto boundary = t.names("boundary");
     const Eigen::Vector2d traction = vec2(t, "traction");  // force per reference length
     std::vector<std::array<int, 2>> edges;
     try {
@@ -181,7 +161,7 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   }
 
   // 7. Interface: named edges -> InterfaceMeshData; Algorithm 2 damping on them.
-  const auto iface = names(s, "interface");
+  const auto iface = s.names("interface");
   std::vector<std::array<int, 2>> iface_edges;
   try {
     iface_edges = mesh_.edges(iface);
@@ -231,8 +211,7 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
 
   // VTK goes to the run's output folder when the driver/coupler asks (time.output_every) and
   // the step is a multiple of solid.output_every (default 1; 0 = the solid writes nothing).
-  output_every_ = s.get<int>("output_every", 1);
-  if (output_every_ < 0) s.fail("output_every", "must be >= 0 (0 = never)");
+  output_every_ = s.get<int>("output_every");
   series_.reset();
   if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid");
 

@@ -68,12 +68,16 @@ class ConfigSection {
   // The key is present and holds a scalar (not a list or a section).
   bool node_is_scalar(const std::string& key) const;
   bool has(const std::string& key) const;
+  // The key is present with a value (not empty, `key:`); marks it as read.
+  bool given(const std::string& key) const;
   template <class T>
   T get(const std::string& key) const;  // required
   template <class T>
   T get(const std::string& key, const T& fallback) const;
   ConfigSection child(const std::string& key) const;  // required map
   std::optional<ConfigSection> optional_child(const std::string& key) const;
+  // The child map if given, otherwise an empty section at its path (its keys take defaults).
+  ConfigSection child_or_empty(const std::string& key) const;
   std::vector<ConfigSection> list(const std::string& key) const;  // sequence of maps
   std::vector<std::string> keys() const;
   const std::string& path() const { return path_; }

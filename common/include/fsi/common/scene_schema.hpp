@@ -1,7 +1,11 @@
 #pragma once
 // The scene schema: every key of every section (time, coupling, solid, fluid and the keys of
 // each solver model), with its type, default, unit, allowed values, meaning and whether it is
-// required. It is the single source of truth for
+// required. Each key is declared once, beside the code that reads it (time: standalone.cpp;
+// coupling: coupler/src/coupling_keys.cpp; solid and fluid: each model's *_keys.cpp), and read
+// through that declaration (scene_reader.hpp), so its name, default and range are written in
+// one place. A component declares its section with `declare()`; the declarations are the
+// single source of truth for
 //   - `fsi check SCENE` (and `fsi run`, which checks first): every key validated without
 //     meshing or starting a process;
 //   - the servers and the coupler, which validate their section against it before they build
@@ -10,6 +14,7 @@
 //
 // A solver section's keys depend on its `model` (solid: sdof, fem; fluid: surrogate, fem);
 // some keys depend on another key (fluid.element, solid.mesh.type, ...): `when` below.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -79,9 +84,17 @@ struct Key {
   std::string selector;
   using Variant = KeyVariant;
   std::vector<Variant> variants;
+  // A top-level section's rules between keys: its reader, run on a scene whose section passed
+  // the key-by-key checks (throws ConfigError).
+  std::function<void(const Scene&)> check;
+
+  // The default depends on other keys (e.g. "8 (iqn-ils), 0 (iqn-imvj)"): `default_value` only
+  // documents it, and the reader computes it (Reader::get_or).
+  bool computed_default = false;
 
   Key& req() { required = true; return *this; }
   Key& def(std::string d) { default_value = std::move(d); return *this; }
+  Key& def_computed(std::string d) { default_value = std::move(d); computed_default = true; return *this; }
   Key& in_unit(std::string u) { unit = std::move(u); return *this; }
   Key& values(std::vector<std::string> v) { allowed = std::move(v); return *this; }
   Key& gt(double v) { lo = v; lo_open = true; return *this; }
@@ -99,8 +112,32 @@ struct Key {
 };
 
 
-// The scene's top-level keys (scene, description, time, coupling, solid, fluid).
-const std::vector<Key>& scene_keys();
+// Building declarations.
+Key number(std::string name, std::string meaning);
+Key integer(std::string name, std::string meaning);
+Key boolean(std::string name, std::string meaning);
+Key text(std::string name, std::string meaning);
+Key choice(std::string name, std::vector<std::string> values, std::string meaning);
+Key vector2(std::string name, std::string meaning);
+Key number_or_vector2(std::string name, std::string meaning);
+Key names(std::string name, std::string meaning);
+Key string_list(std::string name, std::string meaning);
+Key int_list(std::string name, int size, std::string meaning);
+Key point_pair(std::string name, std::string meaning);
+Key section(std::string name, std::string meaning, std::vector<Key> children);
+Key section_list(std::string name, std::string meaning, std::vector<Key> children);
+Key named_map(std::string name, std::string meaning, Key value);
+// A section whose keys depend on its `selector` key (solid.model: sdof | fem).
+Key selector_section(std::string name, std::string meaning, std::string selector, std::vector<KeyVariant> variants);
+
+// Declares a top-level section (coupling, solid, fluid); replaces one of the same name. The
+// components' declaration functions call it, so a program knows the sections it reads; the
+// launcher declares every section.
+void declare(const Key& section);
+
+// The scene's top-level keys: scene, description, time, then the declared sections (coupling,
+// solid, fluid first, in that order).
+std::vector<Key> scene_keys();
 
 struct Problem {
   std::string where;    // "file:line:col", "file (--set key=value)", or "" when in message
@@ -135,6 +172,10 @@ void require_valid(const Scene& scene, const std::vector<std::string>& sections)
 // The same for the scene section a solver server is about to configure; a `model` the schema
 // does not know is left to the server's factory.
 void require_valid(const ConfigSection& section);
+
+// "" when `value` is allowed by the key's values or range, else what it must be ("must be > 0",
+// or the key's own range message).
+std::string range_problem(const Key& k, double value);
 
 // docs/scene-reference.md.
 std::string reference_markdown();

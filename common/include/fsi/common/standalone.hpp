@@ -44,6 +44,8 @@ struct TimeSettings {
   int checkpoint_keep = 2;   // the newest K complete checkpoints are kept
 };
 TimeSettings read_time(const Scene& scene);
+// The declaration of the `time` section (read by read_time).
+const schema::Key& time_section();
 
 // Progress line every few seconds: step, time, extra text, ETA.
 class Progress {

@@ -12,8 +12,9 @@
 //              & Uekermann 2015; preCICE's IQN-IMVJ): the inverse Jacobian of earlier steps
 //              is the prior of this step's least-squares update, without or with restarts.
 // The quasi-Newton schemes' filters (qr1, qr2, qr3) and residual-sum preconditioner: settings.hpp.
-// A new scheme is one file with its class and one line in the registry (its scene keys, if
-// it has any, in common/src/scene_schema_table.cpp).
+// A new scheme is one file with its class and one line in the registry; its name becomes a
+// value of coupling.acceleration by itself (coupling_keys.cpp takes the registry's names), and
+// options of its own, if any, are declared in coupler/src/coupling_keys.cpp.
 // Pure linear algebra: no knowledge of solvers, messages or time.
 #include <Eigen/Core>
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/scene_schema.hpp"
 
 namespace fsi::coupling {
 
@@ -93,8 +94,10 @@ struct CouplingSettings {
   bool combine_all = true;            // iterations.combine: all measures must hold, or any
 };
 
-// Reads the `coupling` section (every key documented in configs/sdof_model.yaml).
+// Reads the `coupling` section through its declaration (coupling_keys.cpp).
 CouplingSettings read_coupling(const ConfigSection& section);
+// The `coupling` section's declaration; the first call declares it to the scene schema.
+const schema::Key& coupling_section();
 
 std::string to_string(Algorithm a);
 std::string to_string(RobinMass m);

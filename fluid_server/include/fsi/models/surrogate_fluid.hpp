@@ -11,9 +11,13 @@
 //   added_mass (0), interface_measure (1)
 #include <Eigen/Core>
 
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi::models {
+
+// The keys of `fluid.model: surrogate` (surrogate_keys.cpp).
+const std::vector<schema::Key>& surrogate_fluid_keys();
 
 class SurrogateFluid : public FluidModel {
  public:

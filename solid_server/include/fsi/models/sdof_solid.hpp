@@ -4,14 +4,16 @@
 // BDF1 (v_{n+1} = (d_{n+1}-d_n)/dt, a_{n+1} = (v_{n+1}-v_n)/dt), both components
 // independent (an isotropic 2D point mass; the paper's problem is the x component).
 //
-// Scene keys (section `solid`, model: sdof):
-//   mass, damping (0), stiffness (0), force (0; number = x, or [fx, fy]),
-//   interface_measure (1: M_G = measure * I), initial_displacement, initial_velocity
+// Scene keys (section `solid`, model: sdof): sdof_keys.cpp.
 #include <Eigen/Core>
 
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi::models {
+
+// The keys of `solid.model: sdof` (sdof_keys.cpp).
+const std::vector<schema::Key>& sdof_solid_keys();
 
 class SdofSolid : public SolidModel {
  public:

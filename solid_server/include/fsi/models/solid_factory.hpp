@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi::models {
@@ -10,4 +11,7 @@ namespace fsi::models {
 // Returns nullptr for an unknown name.
 std::unique_ptr<SolidModel> make_solid_model(const std::string& name);
 std::vector<std::string> solid_model_names();
+// The `solid` section's declaration (every model's keys); the first call declares it to the
+// scene schema.
+const schema::Key& solid_section();
 }  // namespace fsi::models

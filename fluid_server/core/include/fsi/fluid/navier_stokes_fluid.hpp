@@ -13,10 +13,15 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/common/vtk_writer.hpp"
 #include "fsi/fluid/mesh_motion.hpp"
 #include "fsi/fluid/navier_stokes_solver.hpp"
+
+namespace fsi::schema {
+class Reader;
+}
 
 namespace fsi::fluid {
 
@@ -26,6 +31,9 @@ namespace fsi::fluid {
 // the geometry, so curved boundaries are curved).
 std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
                                const std::filesystem::path& cache_dir, int order = 1);
+
+// The keys of `fluid.model: fem` (navier_stokes_keys.cpp).
+const std::vector<schema::Key>& navier_stokes_keys();
 
 class NavierStokesFluid : public FluidModel {
  public:
@@ -83,10 +91,10 @@ class NavierStokesFluid : public FluidModel {
   bool motion_on_vertices_ = false;
   std::vector<int> motion_vertex_index_;  // P2 on vertices: interface index of each moving vertex
   // configure's parts (the scene keys they read: navier_stokes_fluid.cpp).
-  std::vector<std::string> add_boundary_conditions(const ConfigSection& section, const std::string& msh);
-  void configure_mesh_motion(const ConfigSection& section, const std::vector<std::string>& groups,
+  std::vector<std::string> add_boundary_conditions(const schema::Reader& section, const std::string& msh);
+  void configure_mesh_motion(const schema::Reader& section, const std::vector<std::string>& groups,
                              const std::vector<std::string>& fixed_groups);
-  void configure_output(const ConfigSection& section, double density);
+  void configure_output(const schema::Reader& section, double density);
   Eigen::VectorXd motion_input(const Eigen::VectorXd& interface_displacement) const;
   Eigen::MatrixX2d extend(const Eigen::VectorXd& interface_displacement) const;  // every node
   std::unique_ptr<MeshMotion> motion_;

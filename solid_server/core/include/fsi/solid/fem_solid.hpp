@@ -22,6 +22,7 @@
 #include <memory>
 #include <optional>
 
+#include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/common/vtk_writer.hpp"
 #include "fsi/solid/solid_system.hpp"
@@ -36,6 +37,9 @@ struct Probe {
   int cell = -1;
   Eigen::Vector2d xi;  // natural coordinates in `cell`
 };
+
+// The keys of `solid.model: fem` (fem_solid_keys.cpp).
+const std::vector<schema::Key>& fem_solid_keys();
 
 class FemSolid : public fsi::SolidModel {
  public:
