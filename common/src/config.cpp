@@ -1,5 +1,9 @@
 #include "fsi/common/config.hpp"
+
+#include "fsi/common/utf8.hpp"
 #include "fsi/common/scene_schema.hpp"
+
+#include <fmt/format.h>
 
 #include <cmath>
 #include <map>
@@ -112,6 +116,36 @@ void collect_unused(const YAML::Node& node, const std::string& path,
 
 }  // namespace
 
+namespace {
+
+// "file:line:col" of byte `offset` of `text`.
+std::string place_of(const std::string& text, const std::string& origin, std::size_t offset) {
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < offset && i < text.size(); ++i) {
+    if (text[i] == '\n') ++line, column = 1;
+    else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) ++column;  // count characters
+  }
+  return fmt::format("{}:{}:{}", origin, line, column);
+}
+
+// A scene is UTF-8 text without NUL bytes: refused otherwise, naming the place (the YAML reader
+// would take a NUL for the end of a value, and a server could not send the text on).
+void refuse_unreadable_bytes(const std::string& text, const std::string& origin, const std::string& override_text) {
+  const std::string where_prefix = override_text.empty() ? "" : " (--set " + valid_utf8(override_text) + ")";
+  if (text.size() >= 2 && ((text[0] == '\xFF' && text[1] == '\xFE') || (text[0] == '\xFE' && text[1] == '\xFF')))
+    throw ConfigError(origin + where_prefix + ": the file is UTF-16 text; save the scene as UTF-8");
+  if (const auto nul = text.find('\0'); nul != std::string::npos)
+    throw ConfigError((override_text.empty() ? place_of(text, origin, nul) : origin + where_prefix) +
+                      ": a NUL byte (0x00) in the scene; a scene is UTF-8 text");
+  if (const auto bad = first_invalid_utf8(text); bad != std::string::npos)
+    throw ConfigError(fmt::format("{}: byte 0x{:02X} is not UTF-8 (a Latin-1 or other 8-bit character?); save the "
+                                  "scene as UTF-8",
+                                  override_text.empty() ? place_of(text, origin, bad) : origin + where_prefix,
+                                  static_cast<unsigned char>(text[bad])));
+}
+
+}  // namespace
+
 Scene Scene::parse(const std::string& text, const std::string& origin,
                    const std::vector<std::string>& overrides) {
   Scene scene;
@@ -119,6 +153,8 @@ Scene Scene::parse(const std::string& text, const std::string& origin,
   scene.state_->origin = origin;
   scene.state_->text = text;
   scene.state_->overrides = overrides;
+  refuse_unreadable_bytes(text, origin, "");
+  for (const auto& o : overrides) refuse_unreadable_bytes(o, origin, o);
   try {
     scene.state_->root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
@@ -263,9 +299,18 @@ std::filesystem::path ConfigSection::scene_dir() const {
 }
 
 std::filesystem::path ConfigSection::get_path(const std::string& key) const {
-  std::filesystem::path p(get<std::string>(key));
-  if (p.is_absolute()) return p;
-  return scene_dir() / p;
+  namespace fs = std::filesystem;
+  const fs::path given(get<std::string>(key));
+  if (given.is_absolute()) {
+    if (!fs::exists(given)) fail(key, "file '" + given.string() + "' does not exist");
+    return given;
+  }
+  const std::vector<fs::path> candidates = {scene_dir() / given, given, fs::path("configs") / given};
+  for (const auto& c : candidates)
+    if (fs::exists(c)) return fs::absolute(c);
+  std::string tried;
+  for (const auto& c : candidates) tried += (tried.empty() ? "" : ", ") + c.string();
+  fail(key, "file '" + given.string() + "' not found (tried " + tried + ")");
 }
 
 std::vector<std::string> ConfigSection::keys() const {

@@ -148,3 +148,39 @@ TEST(Config, EndMustBeAWholeNumberOfSteps) {
 }
 
 }  // namespace
+
+// A scene is UTF-8 text without NUL bytes: anything else is refused at its place, before any
+// key is read (a Latin-1 comment once passed `fsi check` and failed on the wire; a NUL after a
+// value turned the number into a string).
+TEST(SceneBytes, Latin1ByteIsRefusedWithItsLineAndColumn) {
+  try {
+    (void)fsi::Scene::parse("time: {dt: 0.1, end: 1.0}\n# caf\xE9 au lait\n", "s.yaml");
+    FAIL() << "a Latin-1 byte was accepted";
+  } catch (const fsi::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.yaml:2:6: byte 0xE9 is not UTF-8"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneBytes, NulByteIsRefusedWithItsPlace) {
+  const std::string text = std::string("solid:\n  mass: 1.0") + '\0' + "x\n";
+  try {
+    (void)fsi::Scene::parse(text, "s.yaml");
+    FAIL() << "a NUL byte was accepted";
+  } catch (const fsi::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.yaml:2:12: a NUL byte"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneBytes, Utf16IsRefusedAsUtf16) {
+  const std::string text("\xFF\xFEt\0i\0m\0e\0", 10);
+  EXPECT_THROW((void)fsi::Scene::parse(text, "s.yaml"), fsi::ConfigError);
+  try {
+    (void)fsi::Scene::parse(text, "s.yaml");
+  } catch (const fsi::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("UTF-16"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneBytes, ValidUtf8IsAccepted) {
+  EXPECT_NO_THROW((void)fsi::Scene::parse("description: \"caf\xC3\xA9, \xCE\xB3_N1 = 100\"\n", "s.yaml"));
+}

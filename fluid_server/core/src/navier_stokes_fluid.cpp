@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -19,34 +18,6 @@
 
 namespace fsi::fluid {
 namespace {
-
-// Directory of the scene file that holds `key` (from "file:line:col" or "file (--set)").
-std::filesystem::path scene_directory(const schema::Reader& section, const std::string& key) {
-  std::string where = section.where(key);
-  const std::string set_suffix = " (--set)";
-  if (where.size() > set_suffix.size() && where.compare(where.size() - set_suffix.size(), set_suffix.size(), set_suffix) == 0)
-    where.resize(where.size() - set_suffix.size());
-  else
-    where = std::regex_replace(where, std::regex(":[0-9]+:[0-9]+$"), "");
-  return std::filesystem::path(where).parent_path();
-}
-
-// A path from the scene: absolute; else relative to the scene file; else to the working
-// directory; else to configs/ under the working directory.
-std::filesystem::path resolve_path(const schema::Reader& section, const std::string& key) {
-  const std::filesystem::path given = section.get<std::string>(key);
-  if (given.is_absolute()) {
-    if (!std::filesystem::exists(given)) section.fail(key, "file '" + given.string() + "' does not exist");
-    return given;
-  }
-  std::vector<std::filesystem::path> candidates = {scene_directory(section, key) / given, given,
-                                                   std::filesystem::path("configs") / given};
-  for (const auto& c : candidates)
-    if (std::filesystem::exists(c)) return std::filesystem::absolute(c);
-  std::string tried;
-  for (const auto& c : candidates) tried += (tried.empty() ? "" : ", ") + c.string();
-  section.fail(key, "file '" + given.string() + "' not found (tried " + tried + ")");
-}
 
 std::vector<std::string> string_list(const schema::Reader& section, const std::string& key) {
   return section.get<std::vector<std::string>>(key);
@@ -89,8 +60,8 @@ std::filesystem::path mesh_cache(const schema::Reader& mesh_section) {
 // The .msh file: fluid.mesh.file, or fluid.mesh.geo meshed by gmsh (cached) with the size h,
 // the further parameters and the element order.
 std::filesystem::path mesh_file(const schema::Reader& mesh_section, int order) {
-  if (mesh_section.has("file")) return resolve_path(mesh_section, "file");
-  const auto geo = resolve_path(mesh_section, "geo");
+  if (mesh_section.has("file")) return mesh_section.path("file");
+  const auto geo = mesh_section.path("geo");
   std::map<std::string, double> parameters;
   parameters["h"] = mesh_section.get<double>("size");
   (void)mesh_section.declared("parameters");

@@ -23,19 +23,6 @@ Eigen::Vector2d vec2(const schema::Reader& s, const std::string& key) {
   return {v[0], v[1]};
 }
 
-// A file named in the scene: relative paths are relative to the scene file's folder.
-std::filesystem::path scene_path(const schema::Reader& s, const std::string& key) {
-  std::filesystem::path p = s.get<std::string>(key);
-  if (p.is_absolute()) return p;
-  std::string where = s.where(key);  // "file:line:col"
-  for (int i = 0; i < 2; ++i) {
-    const auto colon = where.rfind(':');
-    if (colon != std::string::npos) where.resize(colon);
-  }
-  const auto candidate = std::filesystem::path(where).parent_path() / p;
-  return std::filesystem::exists(candidate) ? candidate : p;
-}
-
 SolidMesh build_mesh(const schema::Reader& m) {
   const auto type = m.get<std::string>("type");
   if (type == "rectangle") {
@@ -47,7 +34,7 @@ SolidMesh build_mesh(const schema::Reader& m) {
     return rectangle_mesh(origin(0), origin(1), size(0), size(1), n[0], n[1]);
   }
   if (type == "gmsh") {
-    const auto file = scene_path(m, "file");
+    const auto file = m.path("file");
     const auto domain = m.get_or<std::string>("domain", "");
 #ifdef FSI_HAVE_GMSH_READER
     try {

@@ -87,7 +87,9 @@ class ConfigSection {
   const std::vector<std::string>& scene_overrides() const { return state_->overrides; }
   // Directory of the scene file, for resolving relative paths (mesh files).
   std::filesystem::path scene_dir() const;
-  // Resolves a path key: absolute, or relative to the scene file's directory.
+  // Resolves a path key (the one resolver of scene paths): absolute; else relative to the
+  // scene file's folder, the working folder, or configs/ under it, the first that exists; a
+  // ConfigError naming the places tried when none does.
   std::filesystem::path get_path(const std::string& key) const;
   std::string where(const std::string& key) const;  // "file:line:col" of a key
   std::string full_key(const std::string& key) const;

@@ -12,4 +12,8 @@ namespace fsi {
 // "\xNN" (its value in hex); valid text is returned unchanged.
 std::string valid_utf8(std::string_view text);
 
+// The offset of the first byte of `text` that is not part of a well-formed UTF-8 sequence, or
+// npos when the text is valid UTF-8.
+std::size_t first_invalid_utf8(std::string_view text);
+
 }  // namespace fsi
