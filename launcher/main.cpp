@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -80,7 +81,9 @@ Child spawn(const std::string& name, const std::vector<std::string>& argv, const
     setenv("OPENBLAS_NUM_THREADS", "1", 0);
     setpgid(0, 0);                     // own process group: Ctrl-C goes through the launcher
     if (!log.empty()) {
-      FILE* f = std::fopen(log.c_str(), "w");
+      // Appended: a resumed or recovered run keeps its earlier segments' logs (a fresh run's
+      // folder has none, --force removes them).
+      FILE* f = std::fopen(log.c_str(), "a");
       if (f) {
         dup2(fileno(f), STDOUT_FILENO);
         dup2(fileno(f), STDERR_FILENO);
@@ -316,21 +319,6 @@ struct Ending {
   std::string status, reason;
 };
 
-// A scene that fails `fsi check`: nothing was started; the summary says why, as for every
-// other way a run ends (a run to resume keeps the summary it has).
-int refuse_unchecked(const RunOptions& o, const std::string& problems) {
-  try {
-    if (!o.resume) {
-      const auto scene = fsi::Scene::load(o.scene_path, o.overrides);
-      fsi::prepare_output_dir(o.out_dir, o.force ? fsi::OutputMode::Force : fsi::OutputMode::Fresh);
-      finalize_summary(o.out_dir, scene, "failed", "configuration: " + problems, false);
-    }
-  } catch (const std::exception&) {
-    // An unreadable scene or a refused --out: the problems above are the whole story.
-  }
-  return 1;
-}
-
 // Waits for `child`, forwarding a SIGINT/SIGTERM the launcher receives to it once.
 void wait_forwarding_signals(Child& child, std::chrono::milliseconds poll, bool warn) {
   bool forwarded = false;
@@ -498,6 +486,17 @@ void after_coupler(CoupledProcesses& p, Ending& e) {
   }
 }
 
+// An interrupted or failed coupled run with a checkpoint: the exact command that continues it
+// (the checkpoint holds the --set overrides, so none are repeated).
+void say_how_to_resume(const RunOptions& o, const fs::path& out) {
+  if (!fsi::coupling::CheckpointStore(out / "checkpoints", 1).newest()) return;
+  const auto quote = [](const std::string& a) {
+    return a.find_first_of(" '\"$\\") == std::string::npos ? a : "'" + a + "'";
+  };
+  fsi::logger("fsi")->info("continue it with: {} run {} --out {} --resume", quote(fs::read_symlink("/proc/self/exe").string()),
+                           quote(o.scene_path), quote(o.out_dir));
+}
+
 // Coupled: two servers and the coupler; with --recover, a server that dies or stops
 // answering is started again with the same command and address and the run resumes
 // from the last checkpoint.
@@ -527,10 +526,71 @@ int run_coupled(const RunOptions& o, const fsi::Scene& scene, const std::vector<
     e = {1, "failed", fmt::format("the coupler exited with code {}", e.code)};
   finalize_summary(out, scene, e.status.empty() ? "failed" : e.status,
                    e.reason.empty() ? "the coupler ended without a final summary" : e.reason, e.status.empty());
+  if (e.code != 0 && e.code != 2) say_how_to_resume(o, out);
   return e.code;
 }
 
-int run(const RunOptions& o) {
+// --resume, checked before anything in --out is touched (a refused resume changes nothing):
+// a coupled scene, a run folder with a complete checkpoint, and the scene that checkpoint was
+// written with, up to time.end (which may grow: the run is extended). The overrides the run was
+// started with are taken from the checkpoint, so `--resume` alone suffices; --set values given
+// now come after them. Returns the overrides to run with, or nothing when the run is complete
+// (nothing to do, nothing touched).
+std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
+  const fs::path out(o.out_dir);
+  const auto refuse = [&](const std::string& why) {
+    throw fsi::ConfigError(fmt::format("--resume '{}': {}; nothing in the folder was changed", o.out_dir, why));
+  };
+  if (!fs::exists(out / "summary.json")) refuse("not a run folder (no summary.json)");
+  std::vector<std::string> skipped;
+  const auto ckpt = fsi::coupling::CheckpointStore(out / "checkpoints", 1).newest(&skipped);
+  if (!ckpt)
+    refuse(fs::is_directory(out / "checkpoints")
+               ? "no complete checkpoint in " + (out / "checkpoints").string() +
+                     (skipped.empty() ? std::string() : " (" + skipped.front() + ")")
+               : "the run wrote no checkpoints (time.checkpoint_every: 0), so it cannot be continued; run it again "
+                 "into another --out, or with --force");
+  std::vector<std::string> overrides;
+  for (const auto& ov : ckpt->manifest.value("overrides", nlohmann::json::array())) overrides.push_back(ov.get<std::string>());
+  overrides.insert(overrides.end(), o.overrides.begin(), o.overrides.end());
+  const auto scene = fsi::Scene::load(o.scene_path, overrides);
+  if (!scene.has("coupling")) refuse("only coupled runs write checkpoints");
+  std::vector<std::string> differ;
+  bool extended = false;
+  const double end = fsi::read_time(scene).end;
+  for (const auto& d : fsi::coupling::parameter_differences(ckpt->manifest.value("parameters", nlohmann::json::object()),
+                                                            fsi::scene_to_json(scene))) {
+    if (d.rfind("time.end:", 0) == 0) extended = true;
+    else differ.push_back(d);
+  }
+  if (!differ.empty()) {
+    std::string list;
+    for (const auto& d : differ) list += "\n  " + d;
+    refuse(fmt::format("the scene differs from the one checkpoint {} was written with (only time.end may change):{}",
+                       ckpt->dir.string(), list));
+  }
+  if (end < ckpt->time - 1e-12 * std::max(1.0, end))
+    refuse(fmt::format("time.end = {} is before the newest checkpoint (t = {})", end, ckpt->time));
+  const auto summary = read_json(out / "summary.json");
+  if (summary.is_object() && summary.value("status", std::string()) == "completed" && !extended) {
+    fsi::logger("fsi")->info("--resume '{}': the run is complete (t = {}), nothing to do; to extend it: --resume --set "
+                             "time.end=T",
+                             o.out_dir, end);
+    return std::nullopt;
+  }
+  if (extended)
+    fsi::logger("fsi")->info("extending the run to time.end = {} from the checkpoint of step {} (t = {})", end,
+                             ckpt->step, ckpt->time);
+  return overrides;
+}
+
+int run(const RunOptions& given) {
+  RunOptions o = given;
+  if (o.resume) {
+    const auto overrides = prepare_resume(given);
+    if (!overrides) return 0;
+    o.overrides = *overrides;
+  }
   // Every key of every section against the scene schema, before anything starts (fsi check);
   // the sections an external solver reads are its own business.
   std::vector<std::string> external;
@@ -538,7 +598,8 @@ int run(const RunOptions& o) {
   if (!o.fluid_command.empty()) external.push_back("fluid");
   std::string problems;
   if (!fsi::launcher::check_before_run(o.scene_path, o.overrides, external, problems))
-    return refuse_unchecked(o, problems);
+    return 1;  // nothing started, nothing written (the problems are printed): the corrected scene
+               // runs into the same --out without --force
   const auto scene = fsi::Scene::load(o.scene_path, o.overrides);  // fails early on a bad file
   const bool coupled = scene.has("coupling");
   const fs::path out(o.out_dir);

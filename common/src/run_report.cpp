@@ -49,10 +49,14 @@ void prepare_output_dir(const std::filesystem::path& out_dir, OutputMode mode) {
   if (fs::exists(out_dir) && !fs::is_directory(out_dir))
     throw std::runtime_error("--out '" + out_dir.string() + "' exists and is not a folder");
   const bool empty = !fs::exists(out_dir) || fs::is_empty(out_dir);
-  if (!empty && mode == OutputMode::Fresh)
-    throw std::runtime_error("--out '" + out_dir.string() +
-                             "' is not empty: pass --resume to continue the run in it from its last checkpoint, "
-                             "or --force to replace its results");
+  if (!empty && mode == OutputMode::Fresh) {
+    const bool checkpoints = fs::is_directory(out_dir / "checkpoints") && !fs::is_empty(out_dir / "checkpoints");
+    throw std::runtime_error("--out '" + out_dir.string() + "' is not empty: " +
+                             (checkpoints ? "pass --resume to continue the run in it from its last checkpoint, or "
+                                            "--force to replace its results"
+                                          : "choose another --out, or pass --force to replace its results (it has "
+                                            "no checkpoints to --resume from)"));
+  }
   if (!empty && mode == OutputMode::Force) {
     for (const auto& e : fs::directory_iterator(out_dir)) {
       const std::string name = e.path().filename().string();

@@ -217,10 +217,18 @@ struct Coupler::Run {
 RunOutcome Coupler::run(RunReport& report) {
   RunOutcome out;
   const double start = now();
+  // Where an error happened, for its message: configuring, the initial state, or a step.
+  enum class Phase { Configuring, Starting, Stepping } phase = Phase::Configuring;
+  const auto at = [&] {
+    return phase == Phase::Configuring ? std::string("while configuring")
+           : phase == Phase::Starting  ? std::string("while setting up the initial state")
+                                       : fmt::format("at step {}", out.steps + 1);
+  };
   try {
     // 1. Read the scene's coupling part; configure both solvers.
     InterfaceMeshData fluid_interface;
     const TimeSettings time = configure(fluid_interface);
+    phase = Phase::Starting;
     describe_setup(report.data(), time, fluid_interface);
     // 2. Initial state: the newest checkpoint (resume, fork), or the scene's initial state
     //    and the predictor's F_0 = -F*(initial fluid state).
@@ -228,6 +236,7 @@ RunOutcome Coupler::run(RunReport& report) {
     start_state(r);
     // 3. Time loop.
     open_tables(r);
+    phase = Phase::Stepping;
     for (int n = out.steps + 1; n <= time.steps; ++n) {
       Step step = begin_step(r, n);
       for (; step.k <= settings_.max_iterations; ++step.k) {
@@ -250,10 +259,10 @@ RunOutcome Coupler::run(RunReport& report) {
     out.reason = std::string("configuration: ") + e.what();
   } catch (const SolverError& e) {
     out.status = "diverged";
-    out.reason = fmt::format("solver failed at step {}: {}", out.steps + 1, e.what());
+    out.reason = fmt::format("solver failed {}: {}", at(), e.what());
   } catch (const std::exception& e) {
     out.status = "failed";
-    out.reason = fmt::format("at step {}: {}", out.steps + 1, e.what());
+    out.reason = fmt::format("{}: {}", at(), e.what());
   }
   times_.total = now() - start;
   return out;
@@ -462,7 +471,16 @@ void Coupler::find_restart(Run& r) {
 void Coupler::load_restart(Run& r) {
   const CheckpointStore::Loaded& restart = *r.restart;
   const int step = restart.step;
-  const auto diffs = parameter_differences(restart.manifest.value("parameters", nlohmann::json::object()), r.parameters);
+  auto diffs = parameter_differences(restart.manifest.value("parameters", nlohmann::json::object()), r.parameters);
+  // A resumed run may be extended: time.end is the one key that may differ.
+  if (!r.at_fork) {
+    const auto end = std::find_if(diffs.begin(), diffs.end(), [](const std::string& d) { return d.rfind("time.end:", 0) == 0; });
+    if (end != diffs.end()) {
+      r.log->info("extended: {}", *end);
+      r.data["extended"] = *end;
+      diffs.erase(end);
+    }
+  }
   if (r.at_fork) {
     r.data["forked_from"]["changed"] = diffs;
     for (const auto& d : diffs) r.log->info("forked with {}", d);

@@ -57,7 +57,9 @@ RUN = {
     "build/bin/fsi run configs/thick_beam.yaml --out runs/thick --set coupling.algorithm=2": ("append", "--set time.end=0.2"),
     "build/bin/fsi run configs/dfg_2d1.yaml --out runs/dfg_2d1": ("append", COARSE_DFG),
     "build/bin/fsi run configs/thick_beam.yaml --out runs/tb --set time.checkpoint_every=25": ("append", SHORT_TB),
-    "build/bin/fsi run configs/thick_beam.yaml --out runs/tb --set time.checkpoint_every=25 --resume": ("append", SHORT_TB),
+    # The checkpoint holds time.end = 0.6: --resume alone finds the run complete (nothing to do).
+    "build/bin/fsi run configs/thick_beam.yaml --out runs/tb --resume": None,
+    "build/bin/fsi run configs/thick_beam.yaml --out runs/tb --resume --set time.end=4": ("append", "--set time.end=0.8"),
     "build/bin/fsi study studies/thin_beam.yaml --out runs/study_thin --jobs 2":
         ("append", "--set time.end=0.01 --quiet"),
     "build/bin/fsi study studies/thick_beam.yaml --out runs/study_thick --jobs 2": ("append", "--set time.end=0.04 --quiet"),

@@ -20,6 +20,7 @@ Dask distributed.
 import argparse
 import os
 import signal
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -30,7 +31,7 @@ from .analysis import analyse, print_counts
 from .plots import cmd_plot
 from .runner import Runner
 from .spec import GridSource, Study, build_sources, reference_spec
-from .check import check_overrides
+from .check import fsi_has_check, check_overrides
 from .util import REPO, StudyError, clean_value, read_json
 
 
@@ -90,6 +91,18 @@ def dry_run(study, out, sources, n, check_how):
     return 0
 
 
+def check_every_case(study, fsi, sets):
+    """`fsi check STUDY`: every value of every varied key on top of the fixed ones, at the study's
+    line; a study with any invalid case stops here, before anything runs."""
+    if not fsi_has_check(fsi):
+        return
+    scene_sets = [s for s in (sets or []) if "." in s.split("=", 1)[0]]
+    cmd = [fsi, "check", str(study.path)] + [x for s in scene_sets for x in ("--set", s)]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+    if p.returncode != 0:
+        raise StudyError(f"the study has invalid cases; nothing was run:\n{(p.stdout + p.stderr).strip()}")
+
+
 def make_runner(args, study, out, fsi, jobs):
     if args.executor == "local":
         if args.scheduler or args.shared_dir:
@@ -112,6 +125,7 @@ def cmd_run(args):
         raise StudyError(f"fsi executable not found: {fsi} (build it, or pass --fsi)")
     fsi = os.path.abspath(fsi)
     check_how = check_overrides(study, first_specs(study), fsi, cli_sets)
+    check_every_case(study, fsi, args.set)
     jobs = max(1, args.jobs or os.cpu_count() or 1)
     sources, n = build_sources(study)
     ref = reference_spec(study)

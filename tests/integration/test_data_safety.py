@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Nothing a user produced is changed by a command that then fails; a run can be extended.
+
+Each refused command leaves every file of the run folder byte-identical (or creates nothing).
+The runs are the SDOF model problem (configs/sdof_model.yaml: 500 steps, well under a second).
+
+    test_data_safety.py --bin BUILD/bin --source SRC --case NAME
+"""
+import argparse
+import hashlib
+import os
+import subprocess
+import sys
+import tempfile
+
+ARGS = None
+SCENE = "configs/sdof_model.yaml"
+
+
+def fsi(*args):
+    p = subprocess.run([os.path.join(ARGS.bin, "fsi"), *args], capture_output=True, text=True, timeout=120,
+                       cwd=ARGS.source)
+    return p.returncode, p.stdout + p.stderr
+
+
+def snapshot(folder):
+    """{relative path: sha256} of every file under `folder`."""
+    out = {}
+    for root, _, files in os.walk(folder):
+        for name in files:
+            path = os.path.join(root, name)
+            with open(path, "rb") as f:
+                out[os.path.relpath(path, folder)] = hashlib.sha256(f.read()).hexdigest()
+    return out
+
+
+def run_ok(*args):
+    code, text = fsi("run", *args)
+    assert code == 0, f"fsi run {' '.join(args)} exited {code}:\n{text}"
+    return text
+
+
+def refused_unchanged(out, args, expected_text, expected_code=1):
+    before = snapshot(out)
+    code, text = fsi("run", *args)
+    assert code == expected_code, f"expected exit {expected_code}, got {code}:\n{text}"
+    assert expected_text in text, f"expected {expected_text!r} in:\n{text}"
+    after = snapshot(out)
+    assert before == after, f"the folder changed: {sorted(set(before.items()) ^ set(after.items()))}"
+    print(f"refused ({expected_text!r}); {len(before)} files byte-identical")
+
+
+def resume_without_checkpoints(tmp):
+    out = os.path.join(tmp, "run")
+    run_ok(SCENE, "--out", out)
+    refused_unchanged(out, [SCENE, "--out", out, "--resume"], "wrote no checkpoints")
+
+
+def resume_mismatched_scene(tmp):
+    out = os.path.join(tmp, "run")
+    run_ok(SCENE, "--out", out, "--set", "time.checkpoint_every=50", "--set", "time.end=4")
+    refused_unchanged(out, [SCENE, "--out", out, "--resume", "--set", "solid.mass=2"],
+                      "the scene differs from the one checkpoint")
+    # A completed run without a longer time.end: nothing to do (exit 0), nothing touched.
+    refused_unchanged(out, [SCENE, "--out", out, "--resume"], "the run is complete", expected_code=0)
+
+
+def invalid_scene(tmp):
+    bad = os.path.join(tmp, "bad.yaml")
+    with open(os.path.join(ARGS.source, SCENE)) as f:
+        text = f.read()
+    with open(bad, "w") as f:
+        f.write(text.replace("  mass:", "  mas:", 1))
+    fresh = os.path.join(tmp, "fresh")
+    code, out = fsi("run", bad, "--out", fresh)
+    assert code == 1 and "unknown key 'solid.mas'" in out, out
+    assert not os.path.exists(fresh) or not os.listdir(fresh), f"a refused scene wrote {os.listdir(fresh)}"
+    # The corrected scene then runs into the same folder without --force.
+    run_ok(SCENE, "--out", fresh)
+    # An invalid scene pointed at an existing run changes nothing in it.
+    refused_unchanged(fresh, [bad, "--out", fresh, "--force"], "unknown key 'solid.mas'")
+    print("a refused scene wrote nothing; the corrected one ran into the same --out")
+
+
+def extend(tmp):
+    """--resume --set time.end=T2 continues a completed run (its --set overrides from the
+    checkpoint); the tables equal those of one run to T2."""
+    short, whole = os.path.join(tmp, "short"), os.path.join(tmp, "whole")
+    sets = ["--set", "time.checkpoint_every=50", "--set", "coupling.relaxation=0.7", "--set", "coupling.iterations.max=3"]
+    run_ok(SCENE, "--out", short, *sets, "--set", "time.end=4")
+    run_ok(SCENE, "--out", short, "--resume", "--set", "time.end=6")
+    run_ok(SCENE, "--out", whole, *sets, "--set", "time.end=6")
+    for name in ("probes.csv", "iterations.csv"):
+        with open(os.path.join(short, name), "rb") as a, open(os.path.join(whole, name), "rb") as b:
+            assert a.read() == b.read(), f"{name}: the extended run differs from the run to t = 6"
+    print("extended 4 -> 6: probes.csv and iterations.csv byte-identical to one run to 6")
+
+
+def study_invalid_case(tmp):
+    """A study with one invalid value stops before running any case."""
+    study = os.path.join(tmp, "study.yaml")
+    with open(study, "w") as f:
+        f.write(f"study: bad_value\nscene: {os.path.join(ARGS.source, SCENE)}\n"
+                "vary:\n  coupling.relaxation: [0.5, -1.0]\n")
+    out = os.path.join(tmp, "study")
+    code, text = fsi("study", study, "--out", out)
+    assert code != 0, f"a study with an invalid case exited 0:\n{text}"
+    assert "nothing was run" in text and "relaxation" in text, text
+    assert not os.path.exists(os.path.join(out, "runs")), "a case of the invalid study ran"
+    print(f"refused before running (exit {code})")
+
+
+CASES = {"study_invalid_case": study_invalid_case, "resume_without_checkpoints": resume_without_checkpoints, "resume_mismatched_scene": resume_mismatched_scene,
+         "invalid_scene": invalid_scene, "extend": extend}
+
+
+def main():
+    global ARGS
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--bin", required=True)
+    parser.add_argument("--source", required=True)
+    parser.add_argument("--case", required=True, choices=sorted(CASES))
+    ARGS = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        CASES[ARGS.case](tmp)
+
+
+if __name__ == "__main__":
+    main()
