@@ -10,26 +10,43 @@ system site-packages when the isolated environment hides them. So
 
 works with no network and no --no-build-isolation.
 """
+import contextlib
+import os
 import site
 import sys
 import warnings
 
 
-def _setuptools():
-    try:
-        import setuptools.build_meta as backend  # noqa: F401
-        import wheel  # noqa: F401 - setuptools' bdist_wheel needs it
-    except ImportError:
-        # pip's isolated build environment removes the system site-packages from sys.path.
-        for path in site.getsitepackages([sys.base_prefix]):
-            if path not in sys.path:
-                sys.path.append(path)
+def _missing():
+    missing = []
+    for name in ("setuptools", "wheel"):  # setuptools' bdist_wheel needs wheel
         try:
-            import setuptools.build_meta as backend  # noqa: F811
-            import wheel  # noqa: F401
-        except ImportError as e:
-            raise RuntimeError("building fsi needs setuptools (Debian: apt-get install python3-setuptools "
-                               "python3-wheel)") from e
+            __import__(name)
+        except ImportError:
+            missing.append(name)
+    return missing
+
+
+def _setuptools():
+    if _missing():
+        # pip's isolated build environment removes the system site-packages from sys.path; an
+        # interpreter of Debian's minor version (a pyenv or venv Python 3.11) can also use
+        # Debian's own pure-Python setuptools and wheel.
+        paths = list(site.getsitepackages([sys.base_prefix]))
+        if sys.version_info[:2] == (3, 11):
+            paths.append("/usr/lib/python3/dist-packages")
+        for path in paths:
+            if path not in sys.path and os.path.isdir(path):
+                sys.path.append(path)
+    missing = _missing()
+    if missing:
+        raise RuntimeError(
+            f"building fsi needs {' and '.join(missing)} in the interpreter that runs pip ({sys.executable}, "
+            f"Python {sys.version_info[0]}.{sys.version_info[1]}), and pip cannot download them here. Either "
+            f"install them into it ({sys.executable} -m pip install {' '.join(missing)}, from a package index or "
+            f"a local wheel), or make the venv from Debian's Python: /usr/bin/python3 -m venv "
+            f"--system-site-packages VENV (with apt-get install python3-setuptools python3-wheel python3-venv)")
+    import setuptools.build_meta as backend
     return backend
 
 
@@ -52,8 +69,26 @@ def prepare_metadata_for_build_wheel(metadata_directory, config_settings=None):
     return _backend.prepare_metadata_for_build_wheel(metadata_directory, config_settings)
 
 
+@contextlib.contextmanager
+def _source_tree_recorded():
+    """fsi/_source_tree.py in the wheel: the source tree it was built from, so that an installed
+    fsi.run() finds that tree's build/bin/fsi (fsi.results.find_fsi)."""
+    tree = os.path.dirname(os.path.abspath(os.getcwd()))
+    path = os.path.join("fsi", "_source_tree.py")
+    if not os.path.isfile(os.path.join(tree, "CMakeLists.txt")) or os.path.exists(path):
+        yield
+        return
+    with open(path, "w") as f:
+        f.write(f"# Written by the build backend: the source tree this package was built from.\nSOURCE_TREE = {tree!r}\n")
+    try:
+        yield
+    finally:
+        os.remove(path)
+
+
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
-    return _backend.build_wheel(wheel_directory, config_settings, metadata_directory)
+    with _source_tree_recorded():
+        return _backend.build_wheel(wheel_directory, config_settings, metadata_directory)
 
 
 def build_sdist(sdist_directory, config_settings=None):

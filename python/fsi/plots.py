@@ -128,11 +128,15 @@ def work_precision(ax, cost, error, labels, series=None, xlabel="CPU time [s]", 
 
 
 def histories(ax, runs, probe, labels=None):
-    """Plot probe over time for several run folders (paths or fsi.load results), labels in the
-    given order; the legend in numeric order. Returns the lines."""
+    """Plot probe over time for several run folders (paths, fsi.run / fsi.load results), or a
+    {label: run} dict; labels in the given order; the legend in numeric order. Returns the lines."""
     from fsi.results import load, Results
+    if isinstance(runs, dict):
+        labels, runs = list(runs), list(runs.values())
     lines = []
     for i, r in enumerate(runs):
+        if hasattr(r, "out") and not isinstance(r, Results):  # an fsi.run() result: its folder
+            r = r.out
         res = r if isinstance(r, Results) else load(r)
         label = labels[i] if labels else str(res.out)
         lines += ax.plot(res["time"], res[probe], label=label)

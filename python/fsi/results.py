@@ -43,14 +43,21 @@ class RunError(RuntimeError):
 
 
 def find_fsi(fsi=None):
-    """Path of the `fsi` executable: fsi, else $FSI_BIN, else build/bin/fsi next to this
-    package's source tree or under the working directory, else `fsi` on PATH."""
+    """Path of the `fsi` executable: fsi, else $FSI_BIN, else build/bin/fsi of this package's
+    source tree (also when the package is installed: the tree it was built from), or under the
+    working directory, else `fsi` on PATH."""
     if fsi:
         return str(fsi)
     env = os.environ.get("FSI_BIN")
     if env:
         return env
-    for cand in (_SOURCE / "build" / "bin" / "fsi", Path.cwd() / "build" / "bin" / "fsi"):
+    trees = [_SOURCE]
+    try:  # an installed package: the source tree it was built from (written by the build backend)
+        from fsi._source_tree import SOURCE_TREE
+        trees.append(Path(SOURCE_TREE))
+    except ImportError:
+        pass
+    for cand in [t / "build" / "bin" / "fsi" for t in trees] + [Path.cwd() / "build" / "bin" / "fsi"]:
         if cand.is_file() and os.access(cand, os.X_OK):
             return str(cand)
     found = shutil.which("fsi")
@@ -226,7 +233,7 @@ def _stop(proc):
 
 
 def run(scene, out, set=None, force=False, resume=False, solid_command=None, fsi=None, timeout=None,
-        fluid_command=None, reply_timeout=None, recover=None, args=(), check=True, echo=False, cwd=None):
+        fluid_command=None, reply_timeout=None, recover=None, args=(), check=True, echo=True, cwd=None):
     """Run `fsi run scene --out out` and wait for it; returns a Run.
 
     set: {dotted.key: value} overrides (--set key=value; bools as true/false, lists as [a, b]).
@@ -235,8 +242,9 @@ def run(scene, out, set=None, force=False, resume=False, solid_command=None, fsi
     fsi: the executable (default: find_fsi()). timeout: seconds for the whole run (then it is
     interrupted like Ctrl-C and RunError is raised); reply_timeout: fsi's --timeout (seconds the
     coupler waits for a reply). recover: --recover N. args: more command-line arguments.
-    check: raise RunError unless the run completed (exit code 0). echo: print fsi's output as it
-    comes (else it is kept in Run.output). cwd: working directory of fsi (scene and out are
+    check: raise RunError unless the run completed (exit code 0). echo: print fsi's output (its
+    progress) as it comes (default; echo=False keeps it quiet); it is also kept in Run.output.
+    cwd: working directory of fsi (scene and out are
     relative to it).
     """
     cmd = [find_fsi(fsi), "run", str(scene), "--out", str(out)]
