@@ -45,6 +45,10 @@ std::vector<Key> time_keys() {
       integer("output_every", "VTK of both solvers (and the coupling interfaces) every N steps and at t = 0; "
                               "0 = none")
           .def("0").ge(0).in_unit("steps"),
+      choice("vtk_format", {"binary", "ascii"},
+             "VTK encoding: binary = ParaView's default (arrays zlib-compressed in one appended block, doubles "
+             "exact), ascii = text with 10 significant digits")
+          .def("binary"),
       integer("checkpoint_every", "coupled runs: a checkpoint of both solvers and the coupler every N accepted "
                                   "steps; 0 = none")
           .def("0").ge(0).in_unit("steps"),

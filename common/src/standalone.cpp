@@ -116,6 +116,7 @@ TimeSettings read_time(const Scene& scene) {
   if (!(s.dt > 0)) t.fail("dt", "must be positive");
   if (!(s.end > 0)) t.fail("end", "must be positive");
   if (s.output_every < 0) t.fail("output_every", "must be >= 0");
+  s.vtk_format = read_vtk_format(scene);
   s.checkpoint_every = t.get<int>("checkpoint_every", 0);
   s.checkpoint_keep = t.get<int>("checkpoint_keep", 2);
   if (s.checkpoint_every < 0) t.fail("checkpoint_every", "must be >= 0 (0 = no checkpoints)");
@@ -130,6 +131,18 @@ TimeSettings read_time(const Scene& scene) {
                               s.end, s.dt, s.end / s.dt, below * s.dt, below, above * s.dt, above));
   }
   return s;
+}
+
+VtkFormat read_vtk_format(const Scene& scene) {
+  if (!scene.has("time.vtk_format")) return VtkFormat::Binary;
+  const auto t = scene.section("time");
+  const auto name = t.get<std::string>("vtk_format");
+  try {
+    return parse_vtk_format(name);
+  } catch (const std::invalid_argument&) {
+    t.fail("vtk_format", "must be binary or ascii, got '" + name + "'");
+  }
+  return VtkFormat::Binary;
 }
 
 Progress::Progress(std::string logger_name, int total_steps, int first_step)
@@ -154,7 +167,8 @@ int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const 
         const auto section = scene.section("solid");
         model = make_model(factory, section, "solid");
         model->configure(section, SolidSetup{time.dt, time.end, 0.0,
-                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path()});
+                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(),
+                                             time.vtk_format});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {
@@ -174,7 +188,8 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
         const auto section = scene.section("fluid");
         model = make_model(factory, section, "fluid");
         model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0,
-                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path()});
+                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(),
+                                             time.vtk_format});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {

@@ -458,7 +458,7 @@ void NavierStokesFluid::configure_output(const ConfigSection& section, double de
     vtk_every_ = out->get<int>("vtk_every", -1);
     if (vtk_every_ < 0 && out->has("vtk_every")) out->fail("vtk_every", "must be >= 0 (0 = never)");
   }
-  if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid");
+  if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid", setup_.vtk_format);
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {

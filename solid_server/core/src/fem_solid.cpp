@@ -234,7 +234,7 @@ void FemSolid::configure(const ConfigSection& s, const SolidSetup& setup) {
   output_every_ = s.get<int>("output_every", 1);
   if (output_every_ < 0) s.fail("output_every", "must be >= 0 (0 = never)");
   series_.reset();
-  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid");
+  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid", setup.vtk_format);
 
   // 9. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
   const int n = system_->num_dofs();

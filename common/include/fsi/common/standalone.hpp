@@ -40,10 +40,13 @@ struct TimeSettings {
   double end = 0;
   int steps = 0;          // round(end / dt)
   int output_every = 0;   // write VTK every N steps (0 = never)
+  VtkFormat vtk_format = VtkFormat::Binary;  // binary (zlib, appended) or ascii
   int checkpoint_every = 0;  // coupled runs: a checkpoint every N accepted steps (0 = off)
   int checkpoint_keep = 2;   // the newest K complete checkpoints are kept
 };
 TimeSettings read_time(const Scene& scene);
+// time.vtk_format of a scene (default binary), for a server that reads only its own section.
+VtkFormat read_vtk_format(const Scene& scene);
 
 // Progress line every few seconds: step, time, extra text, ETA.
 class Progress {
