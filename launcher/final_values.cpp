@@ -70,11 +70,12 @@ void report_final_values(const fs::path& out) {
       j = nlohmann::json::parse(in, nullptr, false);
     }
     if (!j.is_object()) return;
+    if (j.contains("statistics") && j["statistics"] == stats) return;  // e.g. a command that ran nothing
     j["statistics"] = std::move(stats);
     const fs::path tmp = summary.string() + ".tmp";
     {
       std::ofstream f(tmp);
-      f << j.dump(1) << '\n';
+      f << j.dump(2) << '\n';
       if (!f) throw std::runtime_error("cannot write " + tmp.string());
     }
     fs::rename(tmp, summary);

@@ -146,16 +146,33 @@ VtkFormat read_vtk_format(const Scene& scene) {
 }
 
 Progress::Progress(std::string logger_name, int total_steps, int first_step)
-    : logger_name_(std::move(logger_name)), total_(total_steps), first_(first_step), start_(now_seconds()) {}
+    : logger_name_(std::move(logger_name)),
+      total_(total_steps),
+      first_(first_step),
+      start_(now_seconds()),
+      step_start_(start_) {}
 
 void Progress::update(int step, double time, const std::string& extra) {
   const double now = now_seconds();
+  step_start_ = now;
+  if (first_done_ < 0) first_done_ = now, first_done_step_ = step;
   if (now - last_ < 2.0 && step != total_) return;
   last_ = now;
   const double elapsed = now - start_;
-  const double eta = step > first_ ? elapsed / (step - first_) * (total_ - step) : 0.0;
+  double per_step = 0;
+  if (step > first_done_step_)
+    per_step = (now - first_done_) / (step - first_done_step_);
+  else if (step > first_)
+    per_step = elapsed / (step - first_);
   logger(logger_name_)->info("step {}/{} t={:.5g} {} elapsed {:.1f} s, ETA {:.1f} s", step, total_, time, extra,
-                             elapsed, eta);
+                             elapsed, per_step * (total_ - step));
+}
+
+void Progress::within(int step, const std::string& extra) {
+  const double now = now_seconds();
+  if (now - step_start_ < 2.0 || now - last_ < 2.0) return;  // short steps: the line per step suffices
+  last_ = now;
+  logger(logger_name_)->info("step {}/{} {} (this step: {:.1f} s so far)", step, total_, extra, now - step_start_);
 }
 
 int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir) {

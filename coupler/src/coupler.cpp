@@ -232,6 +232,7 @@ RunOutcome Coupler::run(RunReport& report) {
       Step step = begin_step(r, n);
       for (; step.k <= settings_.max_iterations; ++step.k) {
         const Update u = coupling_iteration(r, step);
+        r.progress->within(n, fmt::format("iteration {} residual {:.2e}", step.k, step.residual));
         const bool met = measures_met(step, u);
         if (finish_iteration(r, step, u, met)) {
           step.converged = true;

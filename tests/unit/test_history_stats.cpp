@@ -93,7 +93,7 @@ TEST(HistoryStats, FewerThanThreePeriodsAreNotPeriodic) {
 TEST(HistoryStats, CrossingsWithHysteresisIgnoreRipple) {
   // A sine with a small fast ripple crosses its mean several times per period without
   // hysteresis, once per period with it.
-  const auto h = sampled(3.0, 1e-4, [](double t) {
+  const auto h = sampled(3.5, 1e-4, [](double t) {  // crossings at t = 1, 2, 3
     return std::sin(2 * M_PI * t) + 0.05 * std::sin(2 * M_PI * 40 * t);
   });
   EXPECT_GT(fsi::upward_crossings(h.t, h.y, 0.0, 0.0).size(), 3u);
