@@ -37,6 +37,7 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
 #include "check.hpp"
+#include "final_values.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/version.hpp"
@@ -265,6 +266,7 @@ struct RunOptions {
   std::vector<std::string> overrides;
   double timeout = 600;
   bool resume = false, force = false;
+  bool plot = false;  // --plot: tools/fsi_plot.py on --out at the end
   int recover = -1;  // -1: 3 when checkpoints are on, else 0
 };
 
@@ -584,6 +586,19 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
   return overrides;
 }
 
+std::string python_interpreter();
+
+// The end of every run that got as far as starting: the final values and statistics of its
+// probes (stdout, summary.json), then with --plot its pictures (fsi plot).
+int after_run(const RunOptions& o, int code) {
+  fsi::launcher::report_final_values(o.out_dir);
+  if (o.plot && code != 130) {
+    const int plotted = fsi::launcher::plot_folder(o.out_dir, python_interpreter(), self_dir());
+    if (plotted != 0) fsi::logger("fsi")->warn("fsi plot {} exited with {}", o.out_dir, plotted);
+  }
+  return code;
+}
+
 int run(const RunOptions& given) {
   RunOptions o = given;
   if (o.resume) {
@@ -611,7 +626,8 @@ int run(const RunOptions& given) {
   }
   std::vector<std::string> sets;
   for (const auto& ov : o.overrides) sets.insert(sets.end(), {"--set", ov});
-  return coupled ? run_coupled(o, scene, sets) : run_single(o, scene, sets);
+  const int code = coupled ? run_coupled(o, scene, sets) : run_single(o, scene, sets);
+  return after_run(o, code);
 }
 
 // The Python interpreter of the project's Python tools: $FSI_PYTHON, else the one CMake found
@@ -673,6 +689,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
       ->capture_default_str();
   run_cmd->add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
   run_cmd->add_flag("--force", o.force, "replace the results of an earlier run in --out");
+  run_cmd->add_flag("--plot", o.plot, "at the end, draw the run's pictures into --out (as fsi plot OUT)");
   run_cmd->add_option("--from", o.from,
                       "start from a checkpoint of another run (its folder: the newest checkpoint; or one "
                       "checkpoints/step_N folder) with this scene and --set changes, into a new --out (the "
@@ -766,6 +783,14 @@ int main(int argc, char** argv) {
       ->required();
   CheckOptions check_options;
   auto* check_cmd = add_check_command(app, check_options);
+  std::string plot_dir;
+  auto* plot_cmd = app.add_subcommand(
+      "plot", "draw the pictures of a run folder (probe histories with their final statistics; Turek-Hron "
+              "FSI1-3 against the reference) or of a study folder (its maps, work-precision, histories), as PNG "
+              "files into that folder, with the Python the build found ($FSI_PYTHON overrides it)");
+  plot_cmd->add_option("folder", plot_dir, "a run folder (fsi run --out) or a study folder (fsi study --out)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   auto* study_cmd = app.add_subcommand(
       "study", "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
                "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
@@ -780,6 +805,7 @@ int main(int argc, char** argv) {
   if (study_cmd->parsed()) return study(study_cmd->remaining());
   if (check_cmd->parsed()) return check(check_options);
   if (keys_cmd->parsed()) return keys(keys_dir);
+  if (plot_cmd->parsed()) return fsi::launcher::plot_folder(plot_dir, python_interpreter(), self_dir());
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {

@@ -10,6 +10,7 @@ packages=(
   python3 python3-zmq python3-protobuf python3-yaml python3-matplotlib python3-psutil
   python3-numpy python3-scipy python3-pandas python3-distributed python3-nbformat
   python3-venv python3-setuptools python3-wheel
+  python3-meshio python3-vtk9   # read the VTK output back in the tests (tests/python/test_vtk_output.py)
   python3-dolfin   # legacy FEniCS: the example external solid python/examples/fenics_solid
 )
 missing=()

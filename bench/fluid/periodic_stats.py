@@ -13,7 +13,9 @@ mean in their CFD/FSI tables).
   --by-period lift   splits the window into the periods of that column (upward crossings of
                      its mean) and prints every column's midrange / amplitude per period: the
                      way to see whether a run has reached its periodic state.
-  --reference cfd3   prints the errors against a published reference (Turek & Hron 2006).
+  --reference cfd3   prints the errors against a published reference (Turek & Hron 2006);
+                     refused (exit 3) when the window holds fewer than 3 whole periods of the
+                     lift (a column with fewer is flagged in any case).
   --harmonics 3      least-squares amplitudes of every column at 1, 2, 3 x the lift frequency
                      (CFD3: the drag oscillates at f and 2f; its f part follows the lift mean).
 """
@@ -28,6 +30,8 @@ import fsi.interpreter  # noqa: E402
 
 fsi.interpreter.require("numpy")  # under another python3: re-run with FSI_PYTHON
 from fsi import stats as fstats  # noqa: E402
+
+MIN_PERIODS = 3  # fewer whole periods in the window: flagged; with --reference: refused (exit 3)
 
 # (midrange mean, amplitude, frequency of the lift) per column
 REFERENCES = {
@@ -72,15 +76,25 @@ def main():
         if a.strouhal_scale:
             s["strouhal"] = s["frequency"] * a.strouhal_scale
         result[c] = s
+        s["too_short"] = s["periods"] < MIN_PERIODS
         print(f"{c:>6}: mean {s['mean']:.6g}  midrange {s['midrange']:.6g}  "
               f"amplitude {s['amplitude']:.6g}  max {s['max']:.6g}  "
               f"min {s['min']:.6g}  frequency {s['frequency']:.5g} Hz ({s['periods']} periods)"
-              + (f"  St {s['strouhal']:.5f}" if a.strouhal_scale else ""))
+              + (f"  St {s['strouhal']:.5f}" if a.strouhal_scale else "")
+              + (f"  FLAGGED: fewer than {MIN_PERIODS} whole periods in the window, not a periodic state "
+                 "(run longer or widen --window)" if s["too_short"] else ""))
     # The published frequency is the lift's (the drag oscillates at twice it, plus a part at it).
     bare = {c: c[len("fluid."):] if c.startswith("fluid.") else c for c in a.columns}
     fcol = next((c for c in a.columns if bare[c] == "lift"), a.columns[0])
     f0 = result[fcol]["frequency"]
     pts = [i for i, ti in enumerate(t) if ti >= t_end - a.window]  # rows of the window
+    if a.reference and result[fcol]["too_short"]:
+        print(f"periodic_stats: refused: {result[fcol]['periods']} whole period(s) of {fcol} in the last "
+              f"{a.window:g} s; at least {MIN_PERIODS} are needed for errors against {a.reference} (run longer "
+              "or widen --window)", file=sys.stderr)
+        if a.json:
+            json.dump(result, open(a.json, "w"), indent=2)
+        return 3
     if a.reference:
         ref = REFERENCES[a.reference]
         print(f"against {a.reference}: midrange +/- amplitude [frequency of {fcol}]")

@@ -121,6 +121,10 @@ const schema::Key& time_section() {
                       .def("0")
                       .ge(0)
                       .in_unit("steps"),
+                  choice("vtk_format", {"binary", "ascii"},
+                         "VTK encoding: binary = ParaView's default (arrays zlib-compressed in one appended block, "
+                         "doubles exact), ascii = text with 10 significant digits")
+                      .def("binary"),
                   integer("checkpoint_every", "coupled runs: a checkpoint of both solvers and the coupler every N "
                                               "accepted steps; 0 = none")
                       .def("0")
@@ -144,6 +148,7 @@ TimeSettings read_time(const Scene& scene) {
   if (!(s.dt > 0)) t.fail("dt", "must be positive");
   if (!(s.end > 0)) t.fail("end", "must be positive");
   if (s.output_every < 0) t.fail("output_every", "must be >= 0");
+  s.vtk_format = read_vtk_format(scene);
   s.checkpoint_every = t.get<int>("checkpoint_every");
   s.checkpoint_keep = t.get<int>("checkpoint_keep");
   if (s.checkpoint_every < 0) t.fail("checkpoint_every", "must be >= 0 (0 = no checkpoints)");
@@ -160,17 +165,39 @@ TimeSettings read_time(const Scene& scene) {
   return s;
 }
 
+VtkFormat read_vtk_format(const Scene& scene) {
+  const schema::Reader t(scene.section("time"), time_section());
+  return parse_vtk_format(t.get<std::string>("vtk_format"));  // the declaration's values: binary, ascii
+}
+
 Progress::Progress(std::string logger_name, int total_steps, int first_step)
-    : logger_name_(std::move(logger_name)), total_(total_steps), first_(first_step), start_(now_seconds()) {}
+    : logger_name_(std::move(logger_name)),
+      total_(total_steps),
+      first_(first_step),
+      start_(now_seconds()),
+      step_start_(start_) {}
 
 void Progress::update(int step, double time, const std::string& extra) {
   const double now = now_seconds();
+  step_start_ = now;
+  if (first_done_ < 0) first_done_ = now, first_done_step_ = step;
   if (now - last_ < 2.0 && step != total_) return;
   last_ = now;
   const double elapsed = now - start_;
-  const double eta = step > first_ ? elapsed / (step - first_) * (total_ - step) : 0.0;
+  double per_step = 0;
+  if (step > first_done_step_)
+    per_step = (now - first_done_) / (step - first_done_step_);
+  else if (step > first_)
+    per_step = elapsed / (step - first_);
   logger(logger_name_)->info("step {}/{} t={:.5g} {} elapsed {:.1f} s, ETA {:.1f} s", step, total_, time, extra,
-                             elapsed, eta);
+                             elapsed, per_step * (total_ - step));
+}
+
+void Progress::within(int step, const std::string& extra) {
+  const double now = now_seconds();
+  if (now - step_start_ < 2.0 || now - last_ < 2.0) return;  // short steps: the line per step suffices
+  last_ = now;
+  logger(logger_name_)->info("step {}/{} {} (this step: {:.1f} s so far)", step, total_, extra, now - step_start_);
 }
 
 int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const std::filesystem::path& out_dir) {
@@ -182,7 +209,8 @@ int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const 
         const auto section = scene.section("solid");
         model = make_model(factory, section, "solid");
         model->configure(section, SolidSetup{time.dt, time.end, 0.0,
-                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path()});
+                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(),
+                                             time.vtk_format});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {
@@ -202,7 +230,8 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
         const auto section = scene.section("fluid");
         model = make_model(factory, section, "fluid");
         model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0,
-                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path()});
+                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(),
+                                             time.vtk_format});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {

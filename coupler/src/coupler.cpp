@@ -170,7 +170,7 @@ struct Coupler::Run {
         store(c.out_dir_ / "checkpoints", time.checkpoint_keep) {
     // Output: both solvers' VTK and the coupling interfaces, every time.output_every steps
     // and at t = 0.
-    if (time.output_every > 0) interface_output.emplace(vtk_dir, c.solid_interface_, fluid_interface);
+    if (time.output_every > 0) interface_output.emplace(vtk_dir, c.solid_interface_, fluid_interface, time.vtk_format);
     const InterfaceMeshData& si = c.solid_interface_;
     const Eigen::VectorXd d_s = si.initial_displacement.size() == 2 * ns ? si.initial_displacement
                                                                           : Eigen::VectorXd::Zero(2 * ns);
@@ -241,6 +241,7 @@ RunOutcome Coupler::run(RunReport& report) {
       Step step = begin_step(r, n);
       for (; step.k <= settings_.max_iterations; ++step.k) {
         const Update u = coupling_iteration(r, step);
+        r.progress->within(n, fmt::format("iteration {} residual {:.2e}", step.k, step.residual));
         const bool met = measures_met(step, u);
         if (finish_iteration(r, step, u, met)) {
           step.converged = true;
@@ -294,13 +295,14 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   {
     Timer t(times_.solid);
     solid_.configure(scene_.section("solid"), SolidSetup{time.dt, time.end, implicit ? gamma : 0.0,
-                                                         time.output_every > 0 ? vtk_dir : std::filesystem::path()});
+                                                         time.output_every > 0 ? vtk_dir : std::filesystem::path(),
+                                                         time.vtk_format});
   }
   {
     Timer t(times_.fluid);
     fluid_.configure(scene_.section("fluid"),
                      FluidSetup{time.dt, time.end, settings_.fluid_penalty, settings_.nitsche_symmetry,
-                                time.output_every > 0 ? vtk_dir : std::filesystem::path()});
+                                time.output_every > 0 ? vtk_dir : std::filesystem::path(), time.vtk_format});
   }
   solid_interface_ = solid_.interface();
   fluid_interface = fluid_.interface();

@@ -33,11 +33,11 @@ Eigen::MatrixXd nodal(const Eigen::VectorXd& v, Eigen::Index n, const char* name
 }  // namespace
 
 InterfaceOutput::InterfaceOutput(const std::filesystem::path& vtk_dir, const InterfaceMeshData& solid,
-                                 const InterfaceMeshData& fluid)
+                                 const InterfaceMeshData& fluid, VtkFormat format)
     : solid_grid_(grid_of(solid)),
       fluid_grid_(grid_of(fluid)),
-      solid_series_(vtk_dir, "interface_solid"),
-      fluid_series_(vtk_dir, "interface_fluid") {}
+      solid_series_(vtk_dir, "interface_solid", format),
+      fluid_series_(vtk_dir, "interface_fluid", format) {}
 
 void InterfaceOutput::write(double time, int step, const InterfaceFields& f) {
   const Eigen::Index ns = solid_grid_.points.rows(), nf = fluid_grid_.points.rows();

@@ -231,7 +231,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
         throw RemoteError(fsi::v1::Error::UNSUPPORTED,
                           fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)",
                                       model->name()));
-      SolidSetup setup{c.dt(), c.end_time(), c.interface_damping(), c.output_dir()};
+      SolidSetup setup{c.dt(), c.end_time(), c.interface_damping(), c.output_dir(), read_vtk_format(scene)};
       model->configure(section, setup);
       scene.check_all_used(section.path());
       model_ = std::move(model);
@@ -311,7 +311,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       const auto section = scene.section(c.section().empty() ? "fluid" : c.section());
       auto model = make_model(factory_, section, "fluid");
       FluidSetup setup{c.dt(), c.end_time(), c.nitsche_penalty(), c.nitsche_symmetry(),
-                       c.output_dir()};
+                       c.output_dir(), read_vtk_format(scene)};
       model->configure(section, setup);
       scene.check_all_used(section.path());
       model_ = std::move(model);

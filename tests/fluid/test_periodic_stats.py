@@ -78,6 +78,16 @@ check(all(abs(q["lift"]["amplitude"] - 430.0) < 0.05 for q in after), "lift ampl
 check(all(abs(q["frequency"] - f) < 1e-3 for q in before + after), "every period lasts 1/f")
 check(all(abs(q["drag"]["amplitude"] - 5.0) < 1e-3 for q in before + after), "drag amplitude 5 in every period")
 
+# A window of fewer than 3 whole periods: flagged; against a reference: refused (exit 3), no errors.
+p5 = subprocess.run(["/usr/bin/python3", str(SCRIPT), str(csv_path), "--columns", "drag", "lift", "--window", "0.5"],
+                    capture_output=True, text=True, timeout=60)
+check(p5.returncode == 0 and "lift" in p5.stdout and p5.stdout.count("FLAGGED: fewer than 3") == 1,
+      f"0.5 s window (2.2 lift periods, 4.4 of the drag): the lift is flagged, the drag not ({p5.stdout.strip()})")
+p6 = subprocess.run(["/usr/bin/python3", str(SCRIPT), str(csv_path), "--columns", "drag", "lift", "--window", "0.5",
+                     "--reference", "cfd3"], capture_output=True, text=True, timeout=60)
+check(p6.returncode == 3 and "at least 3" in p6.stderr and "%" not in p6.stdout,
+      f"0.5 s window with --reference: refused, exit {p6.returncode} ({p6.stderr.strip()})")
+
 # Bad input: a column that does not exist is named, non-zero exit.
 p3 = subprocess.run(["/usr/bin/python3", str(SCRIPT), str(csv_path), "--columns", "drag", "cd"],
                     capture_output=True, text=True, timeout=60)

@@ -416,7 +416,7 @@ void NavierStokesFluid::configure_output(const schema::Reader& section, double d
   if (auto out = section.optional_child("output")) {
     vtk_every_ = out->get_or<int>("vtk_every", -1);
   }
-  if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid");
+  if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid", setup_.vtk_format);
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {

@@ -173,6 +173,9 @@ def cmd_run(args):
             runner.close()
     if interrupted:
         return 130
+    if args.plot:
+        from .plots import cmd_plot
+        cmd_plot(argparse.Namespace(dir=str(out)))
     # Every case failed: none could run (a configuration error, a dead peer, a crash, a lost
     # worker). Divergence and time limits are answers of a study, not failures of it.
     no_run = counts["failed"] + counts["crashes"]
@@ -217,6 +220,7 @@ def main(argv=None):
     r.add_argument("--jobs", type=int, default=0, help="parallel runs (default: number of cores); with --executor dask and no --scheduler: the LocalCluster's workers")
     r.add_argument("--fsi", default="", help="the fsi executable (default: build/bin/fsi or $FSI_BIN)")
     r.add_argument("--quiet", action="store_true", help="no line per run")
+    r.add_argument("--plot", action="store_true", help="at the end, the study's PNGs into --out (as `plot DIR`)")
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an override of every run, like the study's `fixed` (repeatable)")
     r.add_argument("--dry-run", action="store_true",

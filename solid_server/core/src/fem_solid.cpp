@@ -200,7 +200,7 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   // the step is a multiple of solid.output_every (default 1; 0 = the solid writes nothing).
   output_every_ = s.get<int>("output_every");
   series_.reset();
-  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid");
+  if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid", setup.vtk_format);
 
   // 9. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
   const int n = system_->num_dofs();

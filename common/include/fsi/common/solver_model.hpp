@@ -23,6 +23,7 @@
 
 #include "fsi/common/config.hpp"
 #include "fsi/common/state.hpp"
+#include "fsi/common/vtk_writer.hpp"
 
 namespace fsi {
 
@@ -76,6 +77,7 @@ struct SolidSetup {
   double end_time = 0;
   double interface_damping = 0;  // gamma_N1 for Algorithm 2, else 0
   std::filesystem::path output_dir;  // empty = write nothing
+  VtkFormat vtk_format = VtkFormat::Binary;  // time.vtk_format
 };
 
 struct SolidStepResult {
@@ -133,6 +135,7 @@ struct FluidSetup {
   double nitsche_penalty = 0;    // gamma_N1
   double nitsche_symmetry = -1;  // gamma_N2
   std::filesystem::path output_dir;
+  VtkFormat vtk_format = VtkFormat::Binary;  // time.vtk_format
 };
 
 struct FluidLoads {

@@ -40,19 +40,28 @@ struct TimeSettings {
   double end = 0;
   int steps = 0;          // round(end / dt)
   int output_every = 0;   // write VTK every N steps (0 = never)
+  VtkFormat vtk_format = VtkFormat::Binary;  // binary (zlib, appended) or ascii
   int checkpoint_every = 0;  // coupled runs: a checkpoint every N accepted steps (0 = off)
   int checkpoint_keep = 2;   // the newest K complete checkpoints are kept
 };
 TimeSettings read_time(const Scene& scene);
 // The declaration of the `time` section (read by read_time).
 const schema::Key& time_section();
+// time.vtk_format of a scene (default binary), for a server that reads only its own section.
+VtkFormat read_vtk_format(const Scene& scene);
 
 // Progress line every few seconds: step, time, extra text, ETA.
 class Progress {
  public:
   // `first_step`: the step a resumed run starts after (the ETA counts only steps done here).
   Progress(std::string logger_name, int total_steps, int first_step = 0);
+  // After step `step` (t = time): a line every 2 s and at the last step. The ETA is the mean
+  // wall time of the steps after the first one done here (the first carries start-up costs)
+  // times the steps left; after one step, that step's time.
   void update(int step, double time, const std::string& extra = "");
+  // Inside a step (e.g. after each coupling iteration): a line once the step has run for 2 s
+  // and 2 s passed since the last line, so a long step is not silent.
+  void within(int step, const std::string& extra);
 
  private:
   std::string logger_name_;
@@ -60,6 +69,9 @@ class Progress {
   int first_;
   double start_;
   double last_ = -1e9;
+  double step_start_ = 0;       // wall time at the end of the previous step (or at the start)
+  double first_done_ = -1;      // wall time at the end of the first step done here
+  int first_done_step_ = 0;
 };
 
 }  // namespace fsi

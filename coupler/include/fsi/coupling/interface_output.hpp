@@ -27,7 +27,7 @@ struct InterfaceFields {
 class InterfaceOutput {
  public:
   InterfaceOutput(const std::filesystem::path& vtk_dir, const InterfaceMeshData& solid,
-                  const InterfaceMeshData& fluid);
+                  const InterfaceMeshData& fluid, VtkFormat format = VtkFormat::Binary);
   void write(double time, int step, const InterfaceFields& fields);
 
  private:
