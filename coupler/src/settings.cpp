@@ -150,6 +150,22 @@ void read_iterations(const ConfigSection& it, CouplingSettings& c) {
   else it.fail("combine", "must be 'all' (every measure holds) or 'any'");
 }
 
+// coupling.mapping and Wendland's coupling.support_radius.
+void read_mapping(const ConfigSection& s, CouplingSettings& c) {
+  const auto mapping = s.get<std::string>("mapping", "nearest-segment");
+  if (mapping == "nearest-segment") c.mapping.kind = MappingKind::NearestSegment;
+  else if (mapping == "rbf-tps") c.mapping.kind = MappingKind::RbfThinPlateSpline;
+  else if (mapping == "rbf-wendland-c2") c.mapping.kind = MappingKind::RbfWendlandC2;
+  else s.fail("mapping", "must be 'nearest-segment' (projection on the solid's interface segments), 'rbf-tps' "
+                         "(thin-plate splines) or 'rbf-wendland-c2' (Wendland C2, compact support)");
+  if (s.has("support_radius")) {
+    if (c.mapping.kind != MappingKind::RbfWendlandC2)
+      s.fail("support_radius", "is only read with 'mapping: rbf-wendland-c2' (it is '" + mapping + "')");
+    c.mapping.support_radius = s.get<double>("support_radius");
+    if (!(c.mapping.support_radius > 0)) s.fail("support_radius", "must be > 0");
+  }
+}
+
 }  // namespace
 
 CouplingSettings read_coupling(const ConfigSection& s) {
@@ -173,6 +189,7 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   if (robin == "consistent") c.robin_mass = RobinMass::Consistent;
   else if (robin == "solid") c.robin_mass = RobinMass::Solid;
   else s.fail("robin_mass", "must be 'consistent' (the fluid's H^T M_f H) or 'solid' (the solid's own int N^T N)");
+  read_mapping(s, c);
   c.force_limit = s.get<double>("force_limit", 1e12);
   if (!(c.force_limit > 0)) s.fail("force_limit", "must be positive");
   return c;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fsi/common/config.hpp"
+#include "fsi/coupling/interface_map.hpp"
 
 namespace fsi::coupling {
 
@@ -91,6 +92,9 @@ struct CouplingSettings {
   // always k_max iterations (the paper).
   std::vector<ConvergenceMeasure> measures;
   bool combine_all = true;            // iterations.combine: all measures must hold, or any
+  // coupling.mapping (and coupling.support_radius): how interface values move between the
+  // solid's and the fluid's nodes (interface_map.hpp).
+  MappingSettings mapping;
 };
 
 // Reads the `coupling` section (every key documented in configs/sdof_model.yaml).
