@@ -89,6 +89,7 @@ void InterfaceMap::set_from_scalar(const Eigen::MatrixXd& hs) {
   hs_.resize(hs.rows(), hs.cols());
   hs_.setFromTriplets(ts.begin(), ts.end());
   hst_ = hs_.transpose();
+  hs_dense_ = hs;
 }
 
 // RBF interpolation on the solid's interface nodes x_j (the centres), evaluated at the
@@ -212,6 +213,13 @@ NodalMatrix InterfaceMap::mass_to_solid(const NodalMatrix& fluid_mass) const {
   if (fluid_mass.rows() != hs_.rows() || fluid_mass.cols() != hs_.rows())
     throw std::invalid_argument(fmt::format("interface mass of the fluid is {} x {}, expected {} x {} (its interface nodes)",
                                             fluid_mass.rows(), fluid_mass.cols(), hs_.rows(), hs_.rows()));
+  if (hs_dense_.size() > 0) {  // RBF: H is dense, a dense product is much faster than a sparse one
+    const Eigen::MatrixXd mh = fluid_mass * hs_dense_;
+    const Eigen::MatrixXd dense = hs_dense_.transpose() * mh;
+    NodalMatrix m = dense.sparseView(0.0, 0.0);
+    m.makeCompressed();
+    return m;
+  }
   NodalMatrix m = hst_ * fluid_mass * hs_;
   m.makeCompressed();
   return m;

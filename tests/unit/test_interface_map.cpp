@@ -231,11 +231,16 @@ TEST(InterfaceMapRbf, ForcesAreConservative) {
     EXPECT_LT((sum_f - sum_s).lpNorm<Eigen::Infinity>(), 1e-12 * f_f.lpNorm<1>()) << to_string(kind);
     const double work_f = f_f.dot(map.to_fluid(v_s)), work_s = f_s.dot(v_s);
     EXPECT_LT(std::abs(work_f - work_s), 1e-13 * f_f.cwiseAbs().dot(map.to_fluid(v_s).cwiseAbs())) << to_string(kind);
-    // The consistent mass H^T M_f H as in the nearest-segment case.
-    EXPECT_EQ(map.mass_to_solid(fsi::NodalMatrix(Eigen::MatrixXd::Identity(fluid.coordinates.rows(),
-                                                                           fluid.coordinates.rows()).sparseView()))
-                  .rows(),
-              solid.coordinates.rows());
+    // The consistent mass M_G = H^T M_f H (a dense product for RBF): v_s . M_G v_s = v_f . M_f v_f.
+    const fsi::NodalMatrix mf = fsi::coupling::nodal_interface_mass(fluid, Eigen::VectorXd());
+    const fsi::NodalMatrix mg = map.mass_to_solid(mf);
+    const Eigen::VectorXd w_s = Eigen::VectorXd::Random(solid.coordinates.rows());
+    Eigen::VectorXd w2 = Eigen::VectorXd::Zero(2 * w_s.size());  // the x components
+    for (Eigen::Index i = 0; i < w_s.size(); ++i) w2[2 * i] = w_s[i];
+    const Eigen::VectorXd wf2 = map.to_fluid(w2);
+    Eigen::VectorXd w_f(fluid.coordinates.rows());
+    for (Eigen::Index i = 0; i < w_f.size(); ++i) w_f[i] = wf2[2 * i];
+    EXPECT_NEAR(w_s.dot(mg * w_s), w_f.dot(mf * w_f), 1e-13 * w_f.dot(mf * w_f)) << to_string(kind);
   }
 }
 
