@@ -175,7 +175,8 @@ void InterfaceMap::build_rbf(const InterfaceMeshData& solid, const InterfaceMesh
 }
 
 // Conforming? The nearest solid node of every fluid node (detection only: H stays the
-// projection above, which for coinciding nodes is P to round-off).
+// projection above, or the RBF interpolation, either of which is P to round-off for
+// coinciding nodes).
 void InterfaceMap::detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
   const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
   Eigen::Vector2d lo = solid.coordinates.colwise().minCoeff().transpose();
