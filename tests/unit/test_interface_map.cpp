@@ -286,7 +286,7 @@ TEST(InterfaceMapRbf, PointCloudsLinesAndSingleNodes) {
 // interpolation). Thin-plate splines: 2.6-3.7 here. Wendland C2 with the default radius (50 x
 // the spacing, so it shrinks with the mesh: the stationary setting) converges like the others
 // at first and then stalls at 1.5e-5, where a fixed radius would keep converging (at a
-// condition number growing as (R / h)^3).
+// condition number growing 16x per halving of the spacing here).
 TEST(InterfaceMapRbf, SmoothFieldErrorAndOrder) {
   auto u = [](Eigen::Vector2d x) {
     const double xi = (x[0] - 0.24899) / 0.35101, eta = (x[1] - 0.2) / 0.35101;
