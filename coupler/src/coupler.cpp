@@ -308,7 +308,7 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   fluid_interface = fluid_.interface();
   {
     Timer t(times_.coupler);
-    map_ = InterfaceMap(solid_interface_, fluid_interface);
+    map_ = InterfaceMap(solid_interface_, fluid_interface, settings_.mapping);
   }
   return time;
 }
@@ -332,7 +332,15 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
   }
   data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
                        {"max_gap", map_.max_gap()}, {"conforming", map_.conforming()},
-                       {"coincident_nodes", map_.coincident_nodes()}};
+                       {"coincident_nodes", map_.coincident_nodes()}, {"mapping", to_string(map_.kind())}};
+  if (map_.kind() != MappingKind::NearestSegment) {
+    data["interface"]["rbf"] = {{"support_radius", map_.support_radius()}, {"linear_terms", map_.linear_terms()},
+                                {"condition", map_.condition_estimate()}};
+    log->info("mapping {}: RBF on the {} solid interface nodes, {} linear terms{}, condition estimate {:.3g}",
+              to_string(map_.kind()), ns, map_.linear_terms(),
+              map_.support_radius() > 0 ? fmt::format(", support radius {:.4g} m", map_.support_radius()) : "",
+              map_.condition_estimate());
+  }
   if (map_.conforming()) {
     data["interface"]["permutation_error"] = map_.permutation_error();
     log->info("conforming interface: the {} fluid nodes are the solid's (max gap {:.3g} m), H is a permutation "

@@ -119,6 +119,17 @@ schema::Key declare_coupling() {
              "interface mass of the gamma_N1 terms on the solid side: the fluid's H^T M_f H in its current "
              "configuration (cancels exactly at convergence), or the solid's own int N^T N (earlier behaviour)")
           .def("consistent"),
+      choice("mapping", {"nearest-segment", "rbf-tps", "rbf-wendland-c2"},
+             "interface mapping, displacement and velocity consistent (H), forces by H^T: projection on the "
+             "solid's interface segments, or radial basis functions on the solid's nodes with a linear term "
+             "(exact for affine fields): thin-plate splines, or Wendland C2 of radius support_radius")
+          .def("nearest-segment"),
+      number("support_radius", "rbf-wendland-c2: the support radius; default 50 x the largest distance from a "
+                               "solid interface node to its nearest neighbour")
+          .def_computed("50 x node spacing")
+          .gt(0)
+          .in_unit("m")
+          .only_when("mapping", {"rbf-wendland-c2"}, "nearest-segment"),
       number("force_limit", "an interface force above this = diverged").def("1e12").gt(0).in_unit("N"),
 
       });

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,7 +13,15 @@
 
 namespace fsi::coupling {
 
-InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
+std::string to_string(MappingKind k) {
+  return k == MappingKind::NearestSegment       ? "nearest-segment"
+         : k == MappingKind::RbfThinPlateSpline ? "rbf-tps"
+                                                : "rbf-wendland-c2";
+}
+
+InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshData& fluid,
+                           const MappingSettings& mapping)
+    : kind_(mapping.kind) {
   const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
   if (ns == 0 && nf == 0) {
     h_.resize(0, 0);
@@ -59,11 +70,113 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
   hs_.setFromTriplets(ts.begin(), ts.end());
   hst_ = hs_.transpose();
 
+  if (kind_ != MappingKind::NearestSegment) build_rbf(solid, fluid, mapping);
   detect_conforming(solid, fluid);
 }
 
+void InterfaceMap::set_from_scalar(const Eigen::MatrixXd& hs) {
+  std::vector<Eigen::Triplet<double>> t, ts;
+  for (Eigen::Index i = 0; i < hs.rows(); ++i)
+    for (Eigen::Index j = 0; j < hs.cols(); ++j) {
+      const double w = hs(i, j);
+      if (w == 0.0) continue;
+      ts.emplace_back(i, j, w);
+      for (int c = 0; c < 2; ++c) t.emplace_back(2 * i + c, 2 * j + c, w);
+    }
+  h_.resize(2 * hs.rows(), 2 * hs.cols());
+  h_.setFromTriplets(t.begin(), t.end());
+  ht_ = h_.transpose();
+  hs_.resize(hs.rows(), hs.cols());
+  hs_.setFromTriplets(ts.begin(), ts.end());
+  hst_ = hs_.transpose();
+  hs_dense_ = hs;
+}
+
+// RBF interpolation on the solid's interface nodes x_j (the centres), evaluated at the
+// fluid's nodes:  s(x) = sum_j lambda_j phi(|x - x_j|) + p(x),  p linear,
+//   [Phi  P] [lambda]   [u]
+//   [P^T  0] [  a   ] = [0]   (C, symmetric),   H = [Phi_fs  P_f] C^{-1} [I; 0].
+// Coordinates are centred on the solid's nodes and scaled by their bounding-box diagonal L
+// (the thin-plate spline's interpolant does not depend on the scale, given the linear term;
+// Wendland's radius is scaled with them). The linear terms are taken along the principal
+// axes of the solid's nodes, and an axis without extent (nodes on a line) is dropped, as its
+// column of P would be zero and C singular.
+void InterfaceMap::build_rbf(const InterfaceMeshData& solid, const InterfaceMeshData& fluid,
+                             const MappingSettings& mapping) {
+  const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
+  const Eigen::RowVector2d centre = solid.coordinates.colwise().mean();
+  const double diagonal = (solid.coordinates.colwise().maxCoeff() - solid.coordinates.colwise().minCoeff()).norm();
+  const double scale = diagonal > 0 ? diagonal : 1.0;
+  const Eigen::MatrixX2d ys = (solid.coordinates.rowwise() - centre) / scale;
+  const Eigen::MatrixX2d yf = (fluid.coordinates.rowwise() - centre) / scale;
+
+  // Principal axes with an RMS extent above 1e-9 L.
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(ys), Eigen::ComputeFullV);
+  std::vector<Eigen::Vector2d> axes;
+  for (int k = 0; k < 2; ++k)
+    if (svd.singularValues()[k] > 1e-9 * std::sqrt(static_cast<double>(ns))) axes.push_back(svd.matrixV().col(k));
+  linear_terms_ = static_cast<int>(axes.size());
+  const Eigen::Index np = 1 + linear_terms_, n = ns + np;
+
+  // Node spacing: the largest distance from a solid node to its nearest neighbour.
+  double spacing = 0;
+  for (Eigen::Index i = 0; i < ns; ++i) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (Eigen::Index j = 0; j < ns; ++j)
+      if (j != i) nearest = std::min(nearest, (ys.row(i) - ys.row(j)).norm());
+    if (std::isfinite(nearest)) spacing = std::max(spacing, nearest);
+  }
+  const bool wendland = kind_ == MappingKind::RbfWendlandC2;
+  if (wendland) {
+    support_radius_ = mapping.support_radius > 0 ? mapping.support_radius
+                      : spacing > 0             ? MappingSettings::support_factor * spacing * scale
+                                                : scale;
+  }
+  const double radius = support_radius_ / scale;
+  auto phi = [&](double r) {
+    if (wendland) {
+      const double q = r / radius;
+      if (q >= 1) return 0.0;
+      const double a = 1 - q, a2 = a * a;
+      return a2 * a2 * (4 * q + 1);
+    }
+    return r > 0 ? r * r * std::log(r) : 0.0;
+  };
+  auto poly = [&](const Eigen::RowVector2d& y, Eigen::Ref<Eigen::RowVectorXd> row) {
+    row[0] = 1;
+    for (int k = 0; k < linear_terms_; ++k) row[1 + k] = y.dot(axes[static_cast<std::size_t>(k)].transpose());
+  };
+
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < ns; ++i) {
+    for (Eigen::Index j = 0; j < ns; ++j) c(i, j) = phi((ys.row(i) - ys.row(j)).norm());
+    Eigen::RowVectorXd p(np);
+    poly(ys.row(i), p);
+    c.block(i, ns, 1, np) = p;
+    c.block(ns, i, np, 1) = p.transpose();
+  }
+  Eigen::MatrixXd bt(n, nf);  // B^T, B = [Phi_fs  P_f]
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    for (Eigen::Index j = 0; j < ns; ++j) bt(j, i) = phi((yf.row(i) - ys.row(j)).norm());
+    Eigen::RowVectorXd p(np);
+    poly(yf.row(i), p);
+    bt.block(ns, i, np, 1) = p.transpose();
+  }
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(c);
+  if (!lu.isInvertible())
+    throw std::invalid_argument(fmt::format(
+        "coupling.mapping {}: the interpolation system on the solid's {} interface nodes is singular (rank {} of {}: "
+        "coinciding nodes?)",
+        to_string(kind_), ns, lu.rank(), n));
+  condition_ = 1.0 / lu.rcond();
+  // C symmetric: H^T = [I 0] C^{-1} B^T.
+  const Eigen::MatrixXd ht = lu.solve(bt).topRows(ns);
+  set_from_scalar(ht.transpose());
+}
+
 // Conforming? The nearest solid node of every fluid node (detection only: H stays the
-// projection above, which for coinciding nodes is P to round-off).
+// projection above, or the RBF interpolation, either of which is P to round-off for
+// coinciding nodes).
 void InterfaceMap::detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
   const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
   Eigen::Vector2d lo = solid.coordinates.colwise().minCoeff().transpose();
@@ -101,6 +214,13 @@ NodalMatrix InterfaceMap::mass_to_solid(const NodalMatrix& fluid_mass) const {
   if (fluid_mass.rows() != hs_.rows() || fluid_mass.cols() != hs_.rows())
     throw std::invalid_argument(fmt::format("interface mass of the fluid is {} x {}, expected {} x {} (its interface nodes)",
                                             fluid_mass.rows(), fluid_mass.cols(), hs_.rows(), hs_.rows()));
+  if (hs_dense_.size() > 0) {  // RBF: H is dense, a dense product is much faster than a sparse one
+    const Eigen::MatrixXd mh = fluid_mass * hs_dense_;
+    const Eigen::MatrixXd dense = hs_dense_.transpose() * mh;
+    NodalMatrix m = dense.sparseView(0.0, 0.0);
+    m.makeCompressed();
+    return m;
+  }
   NodalMatrix m = hst_ * fluid_mass * hs_;
   m.makeCompressed();
   return m;

@@ -104,6 +104,19 @@ void read_iterations(const schema::Reader& it, CouplingSettings& c) {
   c.combine_all = it.get<std::string>("combine") == "all";
 }
 
+// coupling.mapping and Wendland's coupling.support_radius.
+void read_mapping(const schema::Reader& s, CouplingSettings& c) {
+  const auto mapping = s.get<std::string>("mapping");
+  c.mapping.kind = mapping == "rbf-tps"           ? MappingKind::RbfThinPlateSpline
+                   : mapping == "rbf-wendland-c2" ? MappingKind::RbfWendlandC2
+                                                  : MappingKind::NearestSegment;
+  if (s.has("support_radius")) {
+    if (c.mapping.kind != MappingKind::RbfWendlandC2)
+      s.fail("support_radius", "is only read with 'mapping: rbf-wendland-c2' (it is '" + mapping + "')");
+    c.mapping.support_radius = s.get_or<double>("support_radius", c.mapping.support_radius);
+  }
+}
+
 }  // namespace
 
 CouplingSettings read_coupling(const ConfigSection& section) {
@@ -120,6 +133,7 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   read_schemes(s, c);
   read_iterations(s.child("iterations"), c);
   c.robin_mass = s.get<std::string>("robin_mass") == "solid" ? RobinMass::Solid : RobinMass::Consistent;
+  read_mapping(s, c);
   c.force_limit = s.get<double>("force_limit");
   return c;
 }

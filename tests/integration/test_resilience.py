@@ -312,6 +312,49 @@ def recover_kill(env):
     recovery_trials(env, "solid", "kill", TRIALS or 2, 2)
 
 
+def recover_kill_fenics(env):
+    """kill -9 of an external solid, the FEniCS one (python/examples/fenics_solid): thick_beam to
+    T = 1 with that solid (its default element, Q1), a checkpoint every 5 steps; the solid is killed
+    at step 23, the launcher starts it again, the coupler resumes from step 20 (the solid `load`s
+    its own checkpoint) and the run ends with probes.csv and iterations.csv byte-identical to the
+    uninterrupted run's. Skipped (77) when this Python has no dolfin."""
+    import sys
+    if subprocess.run([sys.executable, "-c", "import dolfin"], capture_output=True).returncode != 0:
+        print(f"skipped: {sys.executable} cannot import dolfin (scripts/install-deps.sh)")
+        sys.exit(77)
+    script = os.path.join(env.source, "python", "examples", "fenics_solid", "fenics_solid.py")
+    solid = ("--solid-command", f"{sys.executable} {script}")
+    sets = ["time.end=1", "time.checkpoint_every=5"]
+    ref = env.out("fenics_ref")
+    t0 = time.time()
+    code, log = finish(launch(env, "thick_beam.yaml", ref, sets, solid), 300)
+    assert code == 0, log[-2000:]
+    t_ref = time.time() - t0
+    out = env.out("fenics_killed")
+    t0 = time.time()
+    p = launch(env, "thick_beam.yaml", out, sets, solid + ("--recover", "1"))
+    wait_rows(os.path.join(out, "probes.csv"), 23, p, 300)
+    victim = None
+    for c in psutil.Process(p.pid).children():
+        try:
+            if any(a.endswith("fenics_solid.py") for a in c.cmdline()):
+                victim = c
+        except psutil.Error:
+            pass
+    assert victim is not None, "the launcher has no fenics_solid.py child"
+    victim.send_signal(signal.SIGKILL)
+    code, log = finish(p, 300)
+    s = assert_final(out, "completed", 0, code)
+    rec = s.get("recoveries", [])
+    assert len(rec) == 1 and rec[0]["process"] == "solid_server" and rec[0]["resumed_from_step"] == 20, rec
+    assert_identical(ref, out)
+    assert_no_leftovers(out)
+    assert not psutil.pid_exists(victim.pid) or victim.status() == psutil.STATUS_ZOMBIE
+    print(f"FEniCS solid killed at step 23: recovered ({rec[0]['cause']}, "
+          f"resumed from step {rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv and "
+          f"iterations.csv identical; {t_ref:.1f} s uninterrupted, {time.time() - t0:.1f} s with the recovery")
+
+
 def recover_stop(env):
     recovery_trials(env, "fluid", "stop", TRIALS or 1, 3)
     recovery_trials(env, "solid", "stop", TRIALS or 1, 4)
@@ -489,4 +532,4 @@ def vtk_output(env):
 
 if __name__ == "__main__":
     main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fsi3, resume_refused, fork, recover_kill,
-                                  recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers, vtk_output)})
+                                  recover_kill_fenics, recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers, vtk_output)})

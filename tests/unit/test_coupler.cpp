@@ -410,6 +410,20 @@ TEST(IqnIls, SettingsOnlyWithIqnIls) {
   EXPECT_EQ(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={reuse_steps: 4, filter: 0.01}"}).reuse_steps, 4);
 }
 
+TEST(InterfaceMapRbf, SettingsMappingAndSupportRadius) {
+  using fsi::coupling::MappingKind;
+  EXPECT_EQ(run_scene_settings({}).mapping.kind, MappingKind::NearestSegment);
+  EXPECT_EQ(run_scene_settings({"coupling.mapping=rbf-tps"}).mapping.kind, MappingKind::RbfThinPlateSpline);
+  const auto w = run_scene_settings({"coupling.mapping=rbf-wendland-c2", "coupling.support_radius=0.05"}).mapping;
+  EXPECT_EQ(w.kind, MappingKind::RbfWendlandC2);
+  EXPECT_DOUBLE_EQ(w.support_radius, 0.05);
+  EXPECT_DOUBLE_EQ(run_scene_settings({"coupling.mapping=rbf-wendland-c2"}).mapping.support_radius, 0.0);
+  EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf"}), fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf-tps", "coupling.support_radius=0.05"}), fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf-wendland-c2", "coupling.support_radius=0"}),
+               fsi::ConfigError);
+}
+
 }  // namespace
 
 namespace {

@@ -103,6 +103,7 @@ TEST(SceneSchema, EveryKeyOfTheSchemaIsReadByItsModel) {
       "time: {dt: 0.1, end: 0.2, output_every: 0, checkpoint_every: 0, checkpoint_keep: 2}\n"
       "coupling: {algorithm: 2, gamma_n1: 10, gamma_n2: -1, relaxation: 1.0, predictor: previous,\n"
       "           acceleration: iqn-ils, iqn: {reuse_steps: 4, filter: 0.01}, force_limit: 1.0e9,\n"
+      "           mapping: rbf-wendland-c2, support_radius: 0.05,\n"
       "           iterations: {max: 3, tolerance: 1.0e-6, stop_if_not_converged: false, divergence_factor: 100}}\n"
       "solid: {model: sdof, mass: 1, damping: 0.1, stiffness: 2, interface_measure: 1, force: [1, 0],\n"
       "        initial_displacement: 0.1, initial_velocity: [0, 0.5]}\n"

@@ -5,6 +5,12 @@
 //  - forces: the transpose, F_s = H^T f_f (conservative), so that the power across the
 //    interface is the same on both sides: F_s . v_s = f_f . v_f exactly.
 // A point interface (no segments) maps node to nearest node.
+// Radial basis functions instead (MappingSettings): H interpolates the solid's nodal values
+// at the fluid's nodes by s(x) = sum_j lambda_j phi(|x - x_j|) + a + b . x over the solid's
+// interface nodes (segments unused), forces again by H^T. The linear term makes H exact for
+// every affine field u(x) = A x + c (rigid translations and rotations of any angle among
+// them), at fluid nodes on or off the solid's boundary; H 1 = 1, so H^T keeps the sum of the
+// forces, and H^T keeps the interface work f_f . H v_s = (H^T f_f) . v_s, both to round-off.
 // Conforming interface: as many fluid as solid nodes, and every fluid node within
 // 1e-9 of the interface's size (the diagonal of the box around both node sets) of a
 // different solid node; H is then a permutation P (to round-off: its rows are the
@@ -12,15 +18,32 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <string>
+
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi::coupling {
+
+// coupling.mapping: the nearest-segment projection (above), or RBF interpolation with a
+// thin-plate spline phi(r) = r^2 log r, or Wendland's C2 function
+// phi(r) = (1 - r/R)^4 (1 + 4 r/R) for r < R (preCICE's compact-polynomial-c2).
+enum class MappingKind { NearestSegment, RbfThinPlateSpline, RbfWendlandC2 };
+
+struct MappingSettings {
+  MappingKind kind = MappingKind::NearestSegment;
+  // Wendland C2's support radius R; 0 = support_factor x the solid's node spacing (the
+  // largest distance from an interface node to its nearest neighbour).
+  double support_radius = 0;
+  static constexpr double support_factor = 50.0;
+};
+
+std::string to_string(MappingKind k);
 
 class InterfaceMap {
  public:
   InterfaceMap() = default;
   // `solid` and `fluid` in the reference configuration.
-  InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshData& fluid);
+  InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshData& fluid, const MappingSettings& mapping = {});
   Eigen::VectorXd to_fluid(const Eigen::VectorXd& solid_values) const { return h_ * solid_values; }
   Eigen::VectorXd to_solid(const Eigen::VectorXd& fluid_forces) const { return ht_ * fluid_forces; }
   const Eigen::SparseMatrix<double>& matrix() const { return h_; }
@@ -35,17 +58,32 @@ class InterfaceMap {
   double coincidence_tolerance() const { return tolerance_; }
   // max |H - P| over the entries of the scalar H, P the permutation; 0 unless conforming.
   double permutation_error() const { return permutation_error_; }
+  MappingKind kind() const { return kind_; }
+  // RBF: the support radius used (Wendland C2; 0 for the thin-plate spline), the linear
+  // terms kept (2 in the plane; 1 for nodes on a line, 0 for a single node) and the
+  // condition number estimate of the interpolation system (reciprocal of LU's rcond).
+  double support_radius() const { return support_radius_; }
+  int linear_terms() const { return linear_terms_; }
+  double condition_estimate() const { return condition_; }
 
  private:
   // Whether H is a permutation (conforming meshes): coincident_nodes_, conforming_, permutation_error_.
   void detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid);
+  // Replaces hs_ by the RBF interpolation matrix (n_f x n_s, dense).
+  void build_rbf(const InterfaceMeshData& solid, const InterfaceMeshData& fluid, const MappingSettings& mapping);
+  void set_from_scalar(const Eigen::MatrixXd& hs);
   Eigen::SparseMatrix<double> h_, ht_;
   Eigen::SparseMatrix<double> hs_, hst_;  // the scalar (per node) H, n_f x n_s, and its transpose
+  Eigen::MatrixXd hs_dense_;               // RBF: the same, dense (empty for the projection)
   double max_gap_ = 0;
   bool conforming_ = false;
   Eigen::Index coincident_nodes_ = 0;
   double tolerance_ = 0;
   double permutation_error_ = 0;
+  MappingKind kind_ = MappingKind::NearestSegment;
+  double support_radius_ = 0;
+  int linear_terms_ = 0;
+  double condition_ = 0;
 };
 
 // M_G = int N^T N dgamma on the solid interface (2n x 2n, consistent, current

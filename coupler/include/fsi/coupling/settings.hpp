@@ -7,6 +7,7 @@
 
 #include "fsi/common/config.hpp"
 #include "fsi/common/scene_schema.hpp"
+#include "fsi/coupling/interface_map.hpp"
 
 namespace fsi::coupling {
 
@@ -92,6 +93,9 @@ struct CouplingSettings {
   // always k_max iterations (the paper).
   std::vector<ConvergenceMeasure> measures;
   bool combine_all = true;            // iterations.combine: all measures must hold, or any
+  // coupling.mapping (and coupling.support_radius): how interface values move between the
+  // solid's and the fluid's nodes (interface_map.hpp).
+  MappingSettings mapping;
 };
 
 // Reads the `coupling` section through its declaration (coupling_keys.cpp).
