@@ -157,8 +157,20 @@ CouplingSettings read_coupling(const ConfigSection& s) {
   const int algorithm = s.get<int>("algorithm");
   if (algorithm != 1 && algorithm != 2) s.fail("algorithm", "must be 1 (explicit) or 2 (implicit solid velocity)");
   c.algorithm = static_cast<Algorithm>(algorithm);
+  const auto scheme = s.get<std::string>("scheme", "serial");
+  if (scheme == "serial") c.scheme = CouplingScheme::Serial;
+  else if (scheme == "parallel") c.scheme = CouplingScheme::Parallel;
+  else s.fail("scheme", "must be 'serial' (solid, then fluid: the paper) or 'parallel' (both at once)");
   c.nitsche_penalty = s.get<double>("gamma_n1");
   if (c.nitsche_penalty < 0) s.fail("gamma_n1", "must be >= 0");
+  const auto robin_auto = s.get<std::string>("robin_auto", "none");
+  if (robin_auto == "none") c.robin_auto = RobinAuto::None;
+  else if (robin_auto == "solid") c.robin_auto = RobinAuto::Solid;
+  else if (robin_auto == "fluid") c.robin_auto = RobinAuto::Fluid;
+  else if (robin_auto == "both") c.robin_auto = RobinAuto::Both;
+  else s.fail("robin_auto", "must be 'none', 'solid', 'fluid' or 'both'");
+  if ((c.robin_auto == RobinAuto::Solid || c.robin_auto == RobinAuto::Both) && algorithm != 2)
+    s.fail("robin_auto", "on the solid side needs algorithm 2 (Algorithm 1 has no Robin term on the solid)");
   c.fluid_penalty = s.get<double>("fluid_penalty", c.nitsche_penalty);
   if (c.fluid_penalty < 0) s.fail("fluid_penalty", "must be >= 0");
   if (c.fluid_penalty == 0 && c.nitsche_penalty > 0)
