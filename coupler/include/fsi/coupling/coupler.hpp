@@ -11,6 +11,8 @@
 //     F*  = f_sigma - gamma f_v                (Algorithm 2)
 //     F^(k+1) = -beta F* + (1 - beta) F^(k)
 //   accept both; F_{n+1} = F^(k+1)
+// coupling.scheme: parallel (settings.hpp) solves the solid with F^(k) and the fluid with the
+// interface state x^(k) = (d^(k), v^(k)) at the same time and relaxes the stacked [d; v; F].
 //
 // Checkpoints (time.checkpoint_every: N): after every N-th accepted step the coupler saves
 // the state of both solvers and its own (F_n, F_{n-1}, the accelerator's reused secant
