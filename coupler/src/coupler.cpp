@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
@@ -16,6 +17,7 @@
 #include "fsi/coupling/checkpoint.hpp"
 #include "fsi/coupling/predictor.hpp"
 
+#include <future>
 #include <optional>
 #include <tuple>
 
@@ -115,6 +117,8 @@ struct Coupler::State {
   double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0, work_uncancelled = 0;
   // M_G = H^T M_f H of the fluid's last solve (empty when the fluid does not send M_f).
   NodalMatrix mapped_mass;
+  // The parallel scheme's block scales of [d; v; F] (0 = not yet set).
+  double scale[3] = {0, 0, 0};
 };
 
 // One coupling iteration's solves; the step accepts its last one.
@@ -138,6 +142,8 @@ struct Coupler::Step {
   bool converged = false;
   std::vector<double> first_r, values;  // the measures' k = 1 quantities and their values
   Eigen::VectorXd d_iter_prev, v_iter_prev;  // the last iteration's solid interface state
+  Eigen::VectorXd x_d, x_v;  // parallel: the interface state x^(k) the fluid is given
+  double gap = 0;            // parallel: |d^(k+1) - d^(k)| / |d^(k+1)| of the last update
   Iterate last;
 };
 
@@ -145,6 +151,9 @@ struct Coupler::Step {
 struct Coupler::Update {
   Iterate iterate;
   Eigen::VectorXd relaxed;  // F^(k+1)
+  Eigen::VectorXd next_d, next_v;  // parallel: x^(k+1)
+  double gap = 0;                  // parallel: |d^(k+1) - d^(k)| / |d^(k+1)|
+  double stacked_change = 0, stacked_residual = 0;  // parallel: |x^(k+1) - x^(k)| scaled, and over |x^(k+1)|
   double norm = 0, change = 0;
   // The interface quantities' changes and sizes: force, traction, displacement, velocity
   // (iterations.csv, convergence measures).
@@ -286,6 +295,7 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
     log->warn("predictor '{}' ({}) can excite interface modes the iterations leave unconverged (docs/fsi.md); "
               "'previous' is the paper's and the robust choice",
               settings_.predictor, predictor_scheme(settings_.predictor).phrase);
+  if (settings_.robin_auto != RobinAuto::None) automatic_robin(time);
   const double gamma = settings_.nitsche_penalty;
   const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
   if (implicit && gamma > 0 && !solid_.supports_interface_damping())
@@ -311,6 +321,28 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
     map_ = InterfaceMap(solid_interface_, fluid_interface, settings_.mapping);
   }
   return time;
+}
+
+// coupling.robin_auto: the solid configured once without damping to report its mass per
+// interface measure; gamma_auto = (m_s / |Gamma|) / dt replaces gamma_N1, gamma_f or both.
+void Coupler::automatic_robin(const TimeSettings& time) {
+  {
+    Timer t(times_.solid);
+    solid_.configure(scene_.section("solid"), SolidSetup{time.dt, time.end, 0.0, {}});
+  }
+  const double mass_per_area = solid_.interface().mass_per_area;
+  if (!(mass_per_area > 0))
+    throw Stop{"failed", fmt::format("coupling.robin_auto needs the solid's mass per interface measure, which "
+                                     "solid '{}' does not report (InterfaceMesh.mass_per_area)", solid_.name())};
+  robin_auto_value_ = mass_per_area / time.dt;
+  if (settings_.robin_auto != RobinAuto::Fluid) settings_.nitsche_penalty = robin_auto_value_;
+  if (settings_.robin_auto != RobinAuto::Solid) settings_.fluid_penalty = robin_auto_value_;
+  if (settings_.nitsche_penalty > 0 && settings_.fluid_penalty == 0)
+    throw Stop{"failed", "coupling.robin_auto: solid sets gamma_N1 > 0 with a fluid penalty of 0: give "
+                         "coupling.fluid_penalty, or robin_auto: both"};
+  logger("coupler")->info("automatic Robin parameter: m_s / |Gamma| = {:.6g}, over dt = {:.6g}: gamma_N1 = {:.6g}, "
+                          "gamma_f = {:.6g}",
+                          mass_per_area, time.dt, settings_.nitsche_penalty, settings_.fluid_penalty);
 }
 
 void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface) {
@@ -370,6 +402,13 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
   data["coupling"]["measures"] = measures;
   data["coupling"]["combine"] = settings_.combine_all ? "all" : "any";
   data["coupling"]["predictor"] = settings_.predictor;
+  if (settings_.robin_auto != RobinAuto::None)
+    data["coupling"]["robin_auto"] = {{"value", robin_auto_value_},
+                                      {"mass_per_area", solid_interface_.mass_per_area},
+                                      {"side", settings_.robin_auto == RobinAuto::Solid   ? "solid"
+                                               : settings_.robin_auto == RobinAuto::Fluid ? "fluid"
+                                                                                          : "both"}};
+  if (settings_.scheme == CouplingScheme::Parallel) data["coupling"]["scheme"] = "parallel";
   if (accelerator_scheme(settings_.acceleration).quasi_newton) {
     const char* filters[] = {"qr1", "qr2", "qr3"};
     const char* restarts[] = {"none", "rs-0", "rs-ls", "rs-svd"};
@@ -561,6 +600,10 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   st.work_fluid = c.real("work_fluid");
   st.work_fluid_on_solid = c.real("work_fluid_on_solid");
   r.out.iterations = static_cast<long>(c.integer("iterations"));
+  if (c.has("parallel.scale")) {
+    const Eigen::VectorXd scale = c.vector("parallel.scale", 3);
+    std::copy(scale.data(), scale.data() + 3, st.scale);
+  }
   r.accelerator->load(c, "accelerator.");
 }
 
@@ -624,6 +667,7 @@ void Coupler::open_tables(Run& r) {
                                              "traction_norm", "displacement_change", "displacement_norm",
                                              "velocity_change", "velocity_norm"};
   for (const auto& m : settings_.measures) iteration_columns.push_back(m.name());
+  if (settings_.scheme == CouplingScheme::Parallel) iteration_columns.push_back("interface_gap");
   const bool resume_tables = r.restart && !r.at_fork;
   const auto kept_steps = resume_tables ? static_cast<std::size_t>(r.restart->step - r.fork_step) : 0;
   r.probes.emplace(resume_tables ? ProbeTable::resume(out_dir_ / "probes.csv", kept_steps)
@@ -656,10 +700,15 @@ Coupler::Step Coupler::begin_step(Run& r, int n) {
   r.accelerator->begin_step();
   step.d_iter_prev = st.d_s_prev;
   step.v_iter_prev = st.v_s_prev;
+  if (settings_.scheme == CouplingScheme::Parallel) {  // the fluid's first interface state
+    step.x_d = st.d_s_prev + r.time.dt * st.v_s_prev;
+    step.x_v = st.v_s_prev;
+  }
   return step;
 }
 
 Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
+  if (settings_.scheme == CouplingScheme::Parallel) return parallel_iteration(r, step);
   const int n = step.n, k = step.k;
   const double gamma = r.gamma;
   if (interrupt_flag())
@@ -727,6 +776,118 @@ Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
   return u;
 }
 
+double Coupler::parallel_gap_limit() const {
+  double limit = std::numeric_limits<double>::infinity();
+  for (const auto& m : settings_.measures) limit = std::min(limit, m.limit);
+  return limit;
+}
+
+// Parallel (Jacobi): the solid with F^(k) and the fluid with x^(k) = (d^(k), v^(k)) at once,
+// then the accelerator on the stacked, scaled [d; v; F] with the residual
+// [d_s - d^(k); v_s - v^(k); -F*(x^(k)) - F^(k)].
+Coupler::Update Coupler::parallel_iteration(Run& r, Step& step) {
+  const int n = step.n, k = step.k;
+  if (interrupt_flag())
+    throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
+  const StepInfo info{step.t_np1, r.time.dt, n, k};
+  Update u;
+  Iterate& it = u.iterate;
+  it.damping = solid_damping_mass(r.state.mapped_mass);
+  if (consistent_damping_ && r.state.mapped_mass.rows() > 0) {
+    Timer t(times_.solid);
+    solid_.set_interface_mass(it.damping);
+  }
+  Eigen::VectorXd v_f;
+  {
+    Timer t(times_.coupler);
+    it.d_f = map_.to_fluid(step.x_d);
+    v_f = map_.to_fluid(step.x_v);
+  }
+  // Each server has its own connection: the solid's request goes from a second thread while
+  // this one waits for the fluid; both wait for the other before anything is thrown.
+  auto solid_job = std::async(std::launch::async, [&] {
+    Timer t(times_.solid);
+    return solid_.solve_step(info, step.force);
+  });
+  try {
+    Timer t(times_.fluid);
+    it.loads = fluid_.solve_step(info, it.d_f, v_f);
+  } catch (...) {
+    solid_job.wait();
+    throw;
+  }
+  it.s = solid_job.get();
+  const SolidStepResult& s = it.s;
+  if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
+    throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
+  Eigen::VectorXd traction_change;
+  {
+    Timer t(times_.coupler);
+    it.mass = map_mass(r, it.loads);
+    const Eigen::VectorXd fs = map_.to_solid(it.loads.traction_force), fv = map_.to_solid(it.loads.velocity_integral);
+    // F* of the interface state the fluid was given.
+    const Eigen::VectorXd f_star = robin_force(fs, fv, step.x_v, step.x_d, it.mass);
+    const double gamma_f = settings_.fluid_penalty;
+    it.traction = gamma_f > 0 ? Eigen::VectorXd(fs - gamma_f * (fv - apply_nodal(physical_mass(step.x_d, it.mass),
+                                                                                  step.x_v)))
+                              : fs;
+    traction_change = it.traction + step.force;
+    if (it.damping.rows() > 0) traction_change -= r.gamma * apply_nodal(it.damping, s.interface_velocity);
+    stacked_update(r, step, u, -f_star - step.force);
+    r.state.mapped_mass = it.mass;
+  }
+  if (!all_finite(u.relaxed) || !all_finite(u.next_d) || !all_finite(u.next_v))
+    throw Stop{"diverged", fmt::format("non-finite interface state at step {} iteration {}", n, k)};
+  u.norm = u.relaxed.norm();
+  u.change = (u.relaxed - step.force).norm();
+  step.residual = u.change / std::max(u.norm, settings_.residual_floor);
+  u.gap = (u.next_d - step.x_d).norm() / std::max(u.next_d.norm(), settings_.residual_floor);
+  const double r_quantity[4] = {u.change, traction_change.norm(), (s.interface_displacement - step.d_iter_prev).norm(),
+                                (s.interface_velocity - step.v_iter_prev).norm()};
+  const double q_quantity[4] = {u.norm, it.traction.norm(), s.interface_displacement.norm(),
+                                s.interface_velocity.norm()};
+  std::copy(r_quantity, r_quantity + 4, u.r_quantity);
+  std::copy(q_quantity, q_quantity + 4, u.q_quantity);
+  step.d_iter_prev = s.interface_displacement;
+  step.v_iter_prev = s.interface_velocity;
+  return u;
+}
+
+// x^(k+1) from the accelerator on the stacked [d; v; F], each block divided by its scale: the
+// size of the block (of x^(k) or of its new value, the larger) when it first is nonzero,
+// renewed at a step's first iteration when the size has moved by more than a factor 10 (the
+// accelerator then starts afresh: its secant pairs are in the old scaling).
+void Coupler::stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force) {
+  const SolidStepResult& s = u.iterate.s;
+  const Eigen::Index m = step.force.size();
+  const Eigen::VectorXd* x[3] = {&step.x_d, &step.x_v, &step.force};
+  const Eigen::VectorXd res[3] = {s.interface_displacement - step.x_d, s.interface_velocity - step.x_v, r_force};
+  double* scale = r.state.scale;
+  if (step.k == 1) {
+    bool renewed = false;
+    for (int b = 0; b < 3; ++b) {
+      const double size = std::max(x[b]->norm(), (*x[b] + res[b]).norm());
+      if (size > settings_.residual_floor && (scale[b] == 0 || size > 10 * scale[b] || size < 0.1 * scale[b]))
+        scale[b] = size, renewed = true;
+    }
+    if (renewed && step.n > 1) {
+      r.accelerator = make_accelerator(settings_);
+      r.accelerator->begin_step();
+    }
+  }
+  Eigen::VectorXd xs(3 * m), rs(3 * m);
+  for (int b = 0; b < 3; ++b) {
+    const double w = scale[b] > 0 ? 1 / scale[b] : 1.0;
+    xs.segment(b * m, m) = w * *x[b];
+    rs.segment(b * m, m) = w * res[b];
+  }
+  const Eigen::VectorXd y = r.accelerator->update(xs, rs);
+  u.stacked_change = (y - xs).norm();
+  u.stacked_residual = u.stacked_change / std::max(y.norm(), settings_.residual_floor);
+  Eigen::VectorXd* out[3] = {&u.next_d, &u.next_v, &u.relaxed};
+  for (int b = 0; b < 3; ++b) *out[b] = (scale[b] > 0 ? scale[b] : 1.0) * y.segment(b * m, m);
+}
+
 bool Coupler::measures_met(Step& step, const Update& u) const {
   bool all_met = true, any_met = false;
   for (std::size_t i = 0; i < settings_.measures.size(); ++i) {
@@ -753,25 +914,33 @@ bool Coupler::finish_iteration(Run& r, Step& step, const Update& u, bool met) {
                                  u.r_quantity[1],    u.q_quantity[1],    u.r_quantity[2],    u.q_quantity[2],
                                  u.r_quantity[3],    u.q_quantity[3]};
   row_values.insert(row_values.end(), step.values.begin(), step.values.end());
+  if (settings_.scheme == CouplingScheme::Parallel) row_values.push_back(u.gap);
   r.iterations.row(row_values);
   step.last = u.iterate;
   step.last.force_applied = step.force;
   step.force = u.relaxed;
+  const bool parallel = settings_.scheme == CouplingScheme::Parallel;
+  if (parallel) step.x_d = u.next_d, step.x_v = u.next_v, step.gap = u.gap;
   ++r.out.iterations;
   if (u.norm > settings_.force_limit)
     throw Stop{"diverged", fmt::format("interface force norm {:.3e} exceeds force_limit {:.3e} at step {} "
                                        "iteration {} (loosely coupled instability?)",
                                        u.norm, settings_.force_limit, n, k)};
-  if (k == 1) step.first_residual = step.residual, step.first_change = u.change;
+  // Parallel: growth is watched on the stacked, scaled [d; v; F] (its force part may start at 0).
+  const double residual = parallel ? u.stacked_residual : step.residual;
+  const double change = parallel ? u.stacked_change : u.change;
+  if (k == 1) step.first_residual = residual, step.first_change = change;
   if (settings_.measures.empty()) return false;
-  if (met) return true;
+  // Parallel: the fluid's interface state must have converged too (below the measures' limit).
+  if (met && (!parallel || u.gap < parallel_gap_limit())) return true;
   // Geometric growth keeps the relative residual constant: watch the absolute change.
-  if (k > 1 && (step.residual > settings_.divergence_factor * std::max(step.first_residual, settings_.residual_floor) ||
-                u.change > settings_.divergence_factor * std::max(step.first_change, settings_.residual_floor)))
-    throw Stop{"diverged", fmt::format("coupling residual grew: |F^(k+1) - F^(k)| from {:.3e} to {:.3e} "
+  if (k > 1 && (residual > settings_.divergence_factor * std::max(step.first_residual, settings_.residual_floor) ||
+                change > settings_.divergence_factor * std::max(step.first_change, settings_.residual_floor)))
+    throw Stop{"diverged", fmt::format("coupling residual grew: {} from {:.3e} to {:.3e} "
                                        "(relative {:.3e} to {:.3e}) at step {} iteration {} "
                                        "(relaxation {} above the stability limit?)",
-                                       step.first_change, u.change, step.first_residual, step.residual, n, k,
+                                       parallel ? "|x^(k+1) - x^(k)| (scaled [d; v; F])" : "|F^(k+1) - F^(k)|",
+                                       step.first_change, change, step.first_residual, residual, n, k,
                                        settings_.relaxation)};
   return false;
 }
@@ -916,6 +1085,8 @@ void Coupler::save_checkpoint(Run& r, int n, double t_np1) {
     c.put("mapped_mass.values", values);
   }
   c.put("iterations", static_cast<std::int64_t>(r.out.iterations));
+  if (settings_.scheme == CouplingScheme::Parallel)
+    c.put("parallel.scale", std::vector<double>(st.scale, st.scale + 3));
   r.accelerator->save(c, "accelerator.");
   parts["coupler"] = c.serialize();
   nlohmann::json manifest = {{"scene", r.data.value("scene", std::string())},

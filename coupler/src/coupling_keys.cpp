@@ -33,7 +33,15 @@ schema::Key declare_coupling() {
                            "damping M_fs = gamma_N1 int N^T N (Algorithm 2)")
           .req()
           .values({"1", "2"}),
+      choice("scheme", {"serial", "parallel"},
+             "serial: the solid, then the fluid with its new interface state (the paper); parallel: both at "
+             "once (Jacobi), accelerated on the stacked interface state and force")
+          .def("serial"),
       number("gamma_n1", "Nitsche penalty gamma_N1 (the Robin parameter)").req().ge(0),
+      choice("robin_auto", {"none", "solid", "fluid", "both"},
+             "the Robin parameter from the solid's mass per interface measure over dt, (m_s / |Gamma|) / dt, "
+             "instead of gamma_n1 (solid: Algorithm 2's damping), of fluid_penalty (fluid), or of both")
+          .def("none"),
       number("fluid_penalty",
              "the fluid's Nitsche penalty gamma_f (weak v_f = v_s); default gamma_n1 (the paper: one parameter). "
              "Set apart, Algorithm 2's converged solution does not depend on gamma_n1; Algorithm 1 uses gamma_f only")

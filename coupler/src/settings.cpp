@@ -123,7 +123,16 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   const schema::Reader s(section, coupling_section());
   CouplingSettings c;
   c.algorithm = static_cast<Algorithm>(s.get<int>("algorithm"));
+  c.scheme = s.get<std::string>("scheme") == "parallel" ? CouplingScheme::Parallel : CouplingScheme::Serial;
   c.nitsche_penalty = s.get<double>("gamma_n1");
+  const auto robin_auto = s.get<std::string>("robin_auto");
+  c.robin_auto = robin_auto == "solid"  ? RobinAuto::Solid
+                 : robin_auto == "fluid" ? RobinAuto::Fluid
+                 : robin_auto == "both"  ? RobinAuto::Both
+                                         : RobinAuto::None;
+  if ((c.robin_auto == RobinAuto::Solid || c.robin_auto == RobinAuto::Both) &&
+      c.algorithm != Algorithm::ImplicitSolidVelocity)
+    s.fail("robin_auto", "on the solid side needs algorithm 2 (Algorithm 1 has no Robin term on the solid)");
   c.fluid_penalty = s.get_or<double>("fluid_penalty", c.nitsche_penalty);
   if (c.fluid_penalty == 0 && c.nitsche_penalty > 0)
     s.fail("fluid_penalty", "must be > 0 when gamma_n1 > 0 (the fluid imposes the solid's velocity by Nitsche's "

@@ -102,6 +102,10 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
                                               i, data.lumped_measure[i]));
   data.initial_displacement = to_eigen(mesh.initial_displacement());
   data.initial_velocity = to_eigen(mesh.initial_velocity());
+  data.mass_per_area = mesh.mass_per_area();
+  if (!(std::isfinite(data.mass_per_area) && data.mass_per_area >= 0))
+    throw std::invalid_argument(fmt::format("interface mesh: mass_per_area is {} (must be finite and >= 0)",
+                                            data.mass_per_area));
   for (const auto& [what, v] : {std::pair<const char*, const Eigen::VectorXd*>{"initial_displacement",
                                                                                &data.initial_displacement},
                                 {"initial_velocity", &data.initial_velocity}}) {
@@ -127,6 +131,7 @@ void interface_to_proto(const InterfaceMeshData& data, fsi::v1::InterfaceMesh* m
   from_eigen(data.lumped_measure, mesh->mutable_lumped_measure());
   from_eigen(data.initial_displacement, mesh->mutable_initial_displacement());
   from_eigen(data.initial_velocity, mesh->mutable_initial_velocity());
+  mesh->set_mass_per_area(data.mass_per_area);
 }
 
 namespace {

@@ -40,6 +40,7 @@ InterfaceMeshData SdofSolid::interface() const {
   data.lumped_measure = Eigen::VectorXd::Constant(1, measure_);
   data.initial_displacement = d0_;
   data.initial_velocity = v0_;
+  data.mass_per_area = mass_ / measure_;
   return data;
 }
 

@@ -148,6 +148,10 @@ RESUME_CASES = {
                                                 "coupling.acceleration=iqn-imvj", "coupling.relaxation=0.5",
                                                 "coupling.iqn={imvj: {restart: rs-svd, chunk_size: 3}, filter_type: qr3, "
                                                 "preconditioner: residual-sum}"], 1250, 60),
+    # The parallel scheme: both servers solve at once; its block scales and IQN-ILS's reused
+    # secant pairs of the stacked [d; v; F] across the checkpoint.
+    "added_mass_parallel": ("added_mass.yaml", ["time.end=20", "time.checkpoint_every=100", "coupling.scheme=parallel",
+                                                "coupling.acceleration=iqn-ils", "coupling.relaxation=0.5"], 1250, 60),
     "thick_beam_imvj": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10", "coupling.algorithm=2",
                                             "coupling.acceleration=iqn-imvj", "coupling.predictor=quadratic",
                                             "coupling.iqn={imvj: {restart: rs-ls, chunk_size: 4, restart_reuse_steps: 2}, "
@@ -192,6 +196,7 @@ def resume_small(env):
     resume_case(env, "added_mass_aitken", "SIGINT")
     resume_case(env, "added_mass_imvj", "kill -9 coupler")
     resume_case(env, "added_mass_imvj_svd", "SIGINT")
+    resume_case(env, "added_mass_parallel", "kill -9 coupler")
     # The Python example solid in place of solid_server saves and loads its own state.
     solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
     RESUME_CASES["python_solid"] = RESUME_CASES["sdof_model"]

@@ -464,3 +464,113 @@ TEST(IqnImvj, OptionsOnlyWithTheirScheme) {
 }
 
 }  // namespace
+
+namespace {
+
+// The added-mass scene of the tests above (m 1, c 0.5, k 4, m_a 10, F 1, dt 0.01, 20 steps).
+std::vector<std::string> added_mass_scene(std::vector<std::string> more) {
+  std::vector<std::string> s{"time.end=0.2", "time.dt=0.01", "solid.mass=1", "solid.damping=0.5",
+                             "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"};
+  s.insert(s.end(), more.begin(), more.end());
+  return s;
+}
+
+TEST(Parallel, ConvergedIsTheMonolithicSolution) {
+  // Jacobi iterations, accelerated on the stacked [d; v; F], reach the same solution as the
+  // serial ones: the monolithic BDF1 recurrence, with constant relaxation below the limit and
+  // the quasi-Newton schemes from beta 0.5, above it. (Aitken's one scalar does not undo the
+  // Jacobi error's rotation: from beta 0.1 it stalls at 1.7e-4 on this problem; not tested.)
+  for (const char* algorithm : {"1", "2"})
+    for (const char* acceleration : {"constant", "iqn-ils", "iqn-imvj"}) {
+      const std::string beta = std::string(acceleration) == "constant" ? "0.1" : "0.5";
+      const auto run = run_scene(added_mass_scene(
+          {"coupling.scheme=parallel", std::string("coupling.algorithm=") + algorithm, "coupling.gamma_n1=10",
+           "coupling.relaxation=" + beta, std::string("coupling.acceleration=") + acceleration,
+           "coupling.iterations.max=2000", "coupling.iterations.tolerance=1e-12"}));
+      ASSERT_EQ(run.outcome.status, "completed") << algorithm << " " << acceleration << ": " << run.outcome.reason;
+      expect_monolithic_added_mass(run.column("solid.d_x"), std::string(algorithm) + " " + acceleration);
+      EXPECT_EQ(run.iteration_columns.back(), "interface_gap");
+      EXPECT_LT(run.iteration_rows.back().back(), 1e-12) << "the fluid's interface state converged too";
+    }
+}
+
+TEST(Parallel, JacobiRelaxationLimitIsTheSerialOne) {
+  // Constant relaxation of the Jacobi iteration on (v, F): the error matrix
+  // [[1 - b, b dt / M], [-b (m_a - G) / dt, 1 - b]] (M = m_eff + G, G = gamma mu dt) has
+  // |lambda|^2 = (1 - b)^2 + b^2 (m_a - G) / M, below 1 iff b < 2 (m_eff + G) / (m_eff + m_a):
+  // the serial limit, reached at the rate sqrt((m_a - G) / (m_eff + m_a)) at best instead of 0.
+  // Also with the automatic Robin parameter (G = m_s = 1, the same as gamma_N1 = 100).
+  for (const std::vector<std::string>& robin : {std::vector<std::string>{"coupling.algorithm=1"},
+                                                 {"coupling.algorithm=2", "coupling.gamma_n1=100"},
+                                                 {"coupling.algorithm=2", "coupling.robin_auto=solid"}}) {
+    const double gamma = robin.size() > 1 ? 100 : 0;
+    const double limit = beta_limit(robin.size() > 1 ? 2 : 1, gamma, 1, 0.5, 4, 10, 0.01);
+    for (const double factor : {0.9, 1.1}) {
+      auto scene = added_mass_scene({"coupling.scheme=parallel", "coupling.relaxation=" + std::to_string(factor * limit),
+                                     "coupling.iterations.max=3000", "coupling.iterations.tolerance=1e-8"});
+      scene.insert(scene.end(), robin.begin(), robin.end());
+      const auto run = run_scene(scene);
+      EXPECT_EQ(run.outcome.status, factor < 1 ? "completed" : "diverged") << robin.back() << " " << factor;
+      if (factor > 1) EXPECT_EQ(run.outcome.steps, 0) << robin.back();
+    }
+  }
+}
+
+// The loosely coupled (one iteration, beta 1, predictor F_n) added-mass model with c = k = 0,
+// serial or parallel, Algorithm 2 with solid damping G / dt (G = gamma mu dt): the
+// solid's displacement history, step by step as the coupler and the two models compute it.
+std::vector<double> loosely_coupled_added_mass(bool parallel, double m, double m_a, double G, double dt, int steps) {
+  double d = 0, v = 0, v_fluid = 0, force = 1;  // F_0 = -F* of the state at rest: the fluid's force 1
+  std::vector<double> out;
+  for (int n = 0; n < steps; ++n) {
+    const double dn = (force + m * (d / (dt * dt) + v / dt) + G / dt * d / dt) / (m / (dt * dt) + G / dt / dt);
+    const double vn = (dn - d) / dt;
+    const double v_in = parallel ? v : vn;  // the fluid's interface velocity
+    force = 1 - m_a * (v_in - v_fluid) / dt + G / dt * v_in;  // -F* = force on the solid + gamma mu v
+    v_fluid = v_in, d = dn, v = vn;
+    out.push_back(d);
+  }
+  return out;
+}
+
+TEST(RobinAuto, LooselyCoupledAddedMassStabilityLimit) {
+  // c = k = 0. The velocity increments w_n = v_n - v_(n-1) of the loosely coupled scheme obey
+  //   serial:   (m + G) w_(n+1) = -m_a w_n                     |z| = m_a / (m + G)
+  //   parallel: (m + G) w_(n+1) + G w_n + m_a w_(n-1) = 0      |z| = sqrt(m_a / (m + G)) (complex pair)
+  // so both are stable iff m_a < m + G (Algorithm 1, G = 0: m_a < m). The automatic Robin
+  // parameter gamma = (m / mu) / dt makes G = m: stable up to m_a = 2 m.
+  const double m = 1, dt = 0.01;
+  for (const bool parallel : {false, true})
+    for (const double factor : {0.9, 1.1}) {
+      const double m_a = factor * 2 * m;
+      const auto run = run_scene({"coupling.algorithm=2", "coupling.gamma_n1=1", "coupling.robin_auto=solid",
+                                  "coupling.relaxation=1", "coupling.iterations.max=1", "coupling.iterations.tolerance=0",
+                                  "coupling.force_limit=1e6", std::string("coupling.scheme=") + (parallel ? "parallel" : "serial"),
+                                  "time.dt=0.01", "time.end=6", "solid.mass=1", "solid.damping=0", "solid.stiffness=0",
+                                  "fluid.added_mass=" + std::to_string(m_a), "fluid.force=1"});
+      const auto expected = loosely_coupled_added_mass(parallel, m, m_a, m, dt, 600);
+      const auto d = run.column("solid.d_x");
+      for (std::size_t n = 0; n < d.size(); ++n)
+        ASSERT_NEAR(d[n], expected[n], 1e-9 * (1 + std::abs(expected[n]))) << parallel << " " << factor << " step " << n + 1;
+      if (factor < 1) {
+        EXPECT_EQ(run.outcome.status, "completed") << parallel << ": " << run.outcome.reason;
+      } else {
+        EXPECT_EQ(run.outcome.status, "diverged") << parallel;
+        EXPECT_NE(run.outcome.reason.find("force_limit"), std::string::npos) << run.outcome.reason;
+      }
+    }
+  // Algorithm 1 (no Robin term on the solid) at m_a = 1.8 m is past its limit m_a < m.
+  const auto alg1 = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0", "coupling.relaxation=1",
+                               "coupling.iterations.max=1", "coupling.force_limit=1e6", "time.dt=0.01", "time.end=6",
+                               "solid.mass=1", "solid.damping=0", "solid.stiffness=0", "fluid.added_mass=1.8",
+                               "fluid.force=1"});
+  EXPECT_EQ(alg1.outcome.status, "diverged");
+}
+
+TEST(RobinAuto, SolidSideNeedsAlgorithm2) {
+  const auto run = run_scene({"coupling.algorithm=1", "coupling.robin_auto=solid"});
+  EXPECT_EQ(run.outcome.status, "failed");
+  EXPECT_NE(run.outcome.reason.find("robin_auto"), std::string::npos) << run.outcome.reason;
+}
+
+}  // namespace

@@ -47,8 +47,23 @@ def sdof_exact(params, t):
     return xs * (1 - (s2 * np.exp(s1 * t) - s1 * np.exp(s2 * t)) / (s2 - s1))
 
 
+def added_mass_monolithic(params, t):
+    """The added-mass model's converged coupled solution: BDF1 of (m + m_a) a + c v + k d = F
+    (F = fluid.force + solid.force) from rest, at the steps t / dt."""
+    m, c, k = _p(params, "solid.mass"), _p(params, "solid.damping", 0.0), _p(params, "solid.stiffness", 0.0)
+    M, dt = m + _p(params, "fluid.added_mass", 0.0), _p(params, "time.dt")
+    F = _p(params, "fluid.force", 0.0) + _p(params, "solid.force", 0.0)
+    steps = np.rint(np.asarray(t, float) / dt).astype(int)
+    d, v, out = 0.0, 0.0, [0.0]
+    for _ in range(int(steps.max(initial=0))):
+        dn = (F + M * (d / (dt * dt) + v / dt) + c * d / dt) / (M / (dt * dt) + c / dt + k)
+        v, d = (dn - d) / dt, dn
+        out.append(d)
+    return np.asarray(out)[steps]
+
+
 SCALAR_FORMS = {"added_mass_beta_c": added_mass_beta_c}
-SERIES_FORMS = {"sdof_exact": sdof_exact}
+SERIES_FORMS = {"sdof_exact": sdof_exact, "added_mass_monolithic": added_mass_monolithic}
 
 
 def namespace(params, t=None):

@@ -172,6 +172,11 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
     interface_.lumped_measure(a) += 0.5 * L;
     interface_.lumped_measure(b) += 0.5 * L;
   }
+  // The solid's mass over its interface measure (the automatic Robin parameter's m_s / |Gamma|):
+  // the consistent mass matrix sums to 2 rho |Omega_s| (two components).
+  if (interface_.lumped_measure.sum() > 0)
+    interface_.mass_per_area = 0.5 * Eigen::VectorXd(system_->mass() * Eigen::VectorXd::Ones(system_->mass().cols())).sum() /
+                               interface_.lumped_measure.sum();
   if (setup.interface_damping < 0) throw ConfigError("interface damping gamma_N1 must be >= 0");
   if (setup.interface_damping > 0) {
     if (iface_edges.empty()) s.fail("interface", "is required when the coupler asks for interface damping");

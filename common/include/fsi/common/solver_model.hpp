@@ -62,6 +62,7 @@ struct InterfaceMeshData {
   Eigen::VectorXd lumped_measure;              // used when segments is empty (size n)
   Eigen::VectorXd initial_displacement;        // 2n, or empty = zero
   Eigen::VectorXd initial_velocity;            // 2n, or empty = zero
+  double mass_per_area = 0;                    // a solid's m_s / |Gamma| (coupling.robin_auto); 0 = unknown
   std::size_t nodes() const { return static_cast<std::size_t>(coordinates.rows()); }
 };
 

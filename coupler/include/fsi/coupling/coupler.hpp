@@ -11,6 +11,8 @@
 //     F*  = f_sigma - gamma f_v                (Algorithm 2)
 //     F^(k+1) = -beta F* + (1 - beta) F^(k)
 //   accept both; F_{n+1} = F^(k+1)
+// coupling.scheme: parallel (settings.hpp) solves the solid with F^(k) and the fluid with the
+// interface state x^(k) = (d^(k), v^(k)) at the same time and relaxes the stacked [d; v; F].
 //
 // Checkpoints (time.checkpoint_every: N): after every N-th accepted step the coupler saves
 // the state of both solvers and its own (F_n, F_{n-1}, the accelerator's reused secant
@@ -100,6 +102,7 @@ class Coupler {
   struct Update;   // what one coupling iteration gives: F^(k+1) and the residual quantities
   // 1. The scene's time and coupling sections; both solvers configured, the interface map.
   TimeSettings configure(InterfaceMeshData& fluid_interface);
+  void automatic_robin(const TimeSettings& time);      // coupling.robin_auto: gamma from the solid's mass
   // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
   void describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface);
   // 2. The state the first step starts from: a checkpoint (resume, fork) or the initial one.
@@ -114,6 +117,9 @@ class Coupler {
   // 3. One step: its iterations, then accept.
   Step begin_step(Run& r, int n);
   Update coupling_iteration(Run& r, Step& step);       // solid, fluid, F*, residual, F^(k+1)
+  Update parallel_iteration(Run& r, Step& step);       // solid and fluid at once, x^(k+1)
+  void stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force);
+  double parallel_gap_limit() const;                   // the interface state's convergence limit
   bool measures_met(Step& step, const Update& u) const;  // the convergence measures
   // The iteration's row in iterations.csv, F^(k+1); throws on divergence; true when converged.
   bool finish_iteration(Run& r, Step& step, const Update& u, bool met);
@@ -126,6 +132,7 @@ class Coupler {
   void write_output(Run& r, const StepInfo& info, const InterfaceFields& fields);
 
   bool consistent_damping_ = false;  // Algorithm 2 and the solid takes H^T M_f H
+  double robin_auto_value_ = 0;      // coupling.robin_auto's (m_s / |Gamma|) / dt
   SolidModel& solid_;
   FluidModel& fluid_;
   const Scene& scene_;

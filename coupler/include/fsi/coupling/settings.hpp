@@ -55,9 +55,25 @@ enum class Preconditioner { None, ResidualSum };
 // last `restart_reuse_steps` steps' secant pairs, rs-svd from a truncated SVD of the
 // accumulated update (singular values below `truncation` x the largest are dropped).
 enum class ImvjRestart { None, Zero, LeastSquares, Svd };
+// The order of the two solves in a coupling iteration (coupling.scheme):
+//   serial    the solid with F^(k), then the fluid with the solid's new interface state
+//             (Gauss-Seidel; the seed paper). The accelerator works on the force F.
+//   parallel  both at once (Jacobi): the solid with F^(k), the fluid with the interface state
+//             x^(k) = (d^(k), v^(k)); the accelerator works on the stacked [d; v; F], each
+//             block scaled by its size (preCICE's parallel implicit coupling). With one
+//             iteration per step it is a parallel explicit scheme: the fluid gets the
+//             predicted d_n + dt v_n, v_n.
+enum class CouplingScheme { Serial, Parallel };
+// The automatic Robin parameter (coupling.robin_auto): gamma_auto = (m_s / |Gamma|) / dt, the
+// solid's mass per interface measure (as the solid reports it) over the time step, replaces
+// gamma_N1 (the solid side: Algorithm 2's damping and its lagged Robin term), the fluid's
+// penalty gamma_f (the fluid side) or both.
+enum class RobinAuto { None, Solid, Fluid, Both };
 
 struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
+  CouplingScheme scheme = CouplingScheme::Serial;
+  RobinAuto robin_auto = RobinAuto::None;
   double nitsche_penalty = 0;     // gamma_N1 >= 0
   // The fluid's Nitsche penalty gamma_f (its weak no-slip v_f = v_s on the interface). The
   // paper uses one parameter: gamma_f = gamma_N1 (the default). Set apart, the converged
