@@ -324,6 +324,16 @@ std::vector<Key> fem_fluid_keys() {
                       .only_when("groups")
                       .only_when(element, {"p2p1"}, "p1p1"),
               }),
+      section("remesh", "remeshing when the moving mesh's quality drops (boundary nodes kept, interior by gmsh)",
+              {
+                  boolean("enabled", "remesh when the quality falls below min_quality").def(
+                      "true with fluid.interface.groups"),
+                  number("min_quality", "minimum scaled Jacobian that triggers a remesh").def("0.15").lt(1),
+                  number("min_curved_jacobian", "P2: minimum relative curved Jacobian that triggers a remesh")
+                      .def("0.3")
+                      .only_when(element, {"p2p1"}, "p1p1"),
+                  make("at_steps", Type::IntList, "remesh after these steps in any case (tests)"),
+              }),
       section_list("inflow", "velocity inlets",
                    {
                        text("group", "boundary group").req(),
