@@ -204,8 +204,13 @@ TEST_P(FluidRemesh, ForcedRemeshChangesTheForcesByLittle) {
   EXPECT_EQ(b.model.timings().at("remeshes"), 1);
   EXPECT_EQ(a.model.timings().count("remeshes"), 0u);
   EXPECT_GT(std::abs(ra.probes.at("cyl_cd")), 0.05);
-  // Measured: p1p1 REL_P1, p2p1 REL_P2 (another mesh of the same sizes: its discretisation error).
-  EXPECT_LT(worst, GetParam() == "p1p1" ? 0.05 : 0.05) << "worst relative C_D change after the remesh " << worst;
+  // A violent start (inflow ramped over 5 steps, the cylinder shaken) on a coarse mesh (539
+  // nodes): the change is the two meshes' different discretisation errors plus the transfer.
+  // Measured: worst over the 6 steps after the remesh 0.41 (p1p1, the first step: the
+  // interpolated velocity is not discretely divergence-free) and 0.083 (p2p1); 6 steps
+  // after it 5.2 % and 0.71 %.
+  EXPECT_LT(worst, GetParam() == "p1p1" ? 0.6 : 0.15) << "worst relative C_D change after the remesh " << worst;
+  EXPECT_NEAR(rb.probes.at("cyl_cd"), ra.probes.at("cyl_cd"), (GetParam() == "p1p1" ? 0.1 : 0.015) * ra.probes.at("cyl_cd"));
   std::printf("%s: worst relative C_D change after the remesh %.3e, at step %d %.6f vs %.6f\n", GetParam().c_str(),
               worst, n, rb.probes.at("cyl_cd"), ra.probes.at("cyl_cd"));
 }
@@ -252,6 +257,32 @@ TEST_P(FluidRemesh, CheckpointsAcrossARemeshRestoreBitForBit) {
   }
 }
 
+// Steady DFG 2D-1 (Re 20) with P2/P1 and Newton on a coarse mesh: a forced remesh after the
+// first steady solve; the second solves on the new mesh from the interpolated solution.
+TEST(FluidRemeshSteady, Dfg2d1ForcedRemeshMovesTheDragByLittle) {
+  auto scene = fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1_p2p1.yaml",
+                                {"fluid.mesh.size=0.08", "fluid.mesh.parameters.hc=0.01", "fluid.remesh.at_steps=[1]"});
+  fsi::FluidSetup setup;
+  setup.dt = 1.0;
+  setup.end_time = 2.0;
+  NavierStokesFluid model;
+  model.configure(scene.section("fluid"), setup);
+  std::map<std::string, double> p[2];
+  for (int step = 1; step <= 2; ++step) {
+    model.solve_step(fsi::StepInfo{1.0 * step, 1.0, step, 1}, Eigen::VectorXd(), Eigen::VectorXd());
+    p[step - 1] = model.accept_step(fsi::StepInfo{1.0 * step, 1.0, step, 1});
+  }
+  EXPECT_EQ(model.timings().at("remeshes"), 1);
+  const double cd1 = p[0].at("cd"), cd2 = p[1].at("cd");
+  std::printf("C_D %.7f -> %.7f (relative %.2e), Newton solves %g -> %g\n", cd1, cd2, (cd2 - cd1) / cd1,
+              p[0].at("nonlinear_iterations"), p[1].at("nonlinear_iterations"));
+  EXPECT_NEAR(cd1, 5.57954, 0.01 * 5.57954);
+  EXPECT_LT(std::abs(cd2 - cd1) / cd1, 1e-4);  // measured 5.7e-5 (C_D 5.57824 -> 5.57856), Newton solves 6 -> 3
+  // The transferred solution is a good start: fewer Newton solves than from rest.
+  EXPECT_LT(p[1].at("nonlinear_iterations"), p[0].at("nonlinear_iterations"));
+}
+
 INSTANTIATE_TEST_SUITE_P(Elements, FluidRemesh, ::testing::Values(std::string("p1p1"), std::string("p2p1")));
 
 }  // namespace
+

@@ -506,7 +506,8 @@ void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
   const auto t0 = std::chrono::steady_clock::now();
   const FlowSolver& old = *solver_;
   const MeshQuality before = mesh_quality(old.mesh(), old.accepted_positions());
-  RemeshResult r = fluid::remesh(old.mesh(), old.accepted_positions());
+  if (remesh_size_.size() == 0) remesh_size_ = reference_sizes(old.mesh());
+  RemeshResult r = fluid::remesh(old.mesh(), old.accepted_positions(), remesh_size_);
   auto fresh = make_solver(std::move(r.mesh), old.parameters());
   const auto &oi = old.interface_nodes(), &ni = fresh->interface_nodes();
   bool same = oi.size() == ni.size();
@@ -523,6 +524,7 @@ void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
   }
   const int old_nodes = old.mesh().node_count();
   solver_ = std::move(fresh);
+  remesh_size_ = std::move(r.vertex_size);
   if (motion_) build_mesh_motion();
   const MeshQuality after = mesh_quality(solver_->mesh(), solver_->mesh().nodes);
   remesh_quality_ = std::min(after.min_scaled_jacobian, solver_->mesh().quadratic() ? after.min_curved_jacobian / remesh_.min_curved_jacobian * remesh_.min_quality : 1.0);
@@ -562,7 +564,7 @@ void index_matrix(const StateArchive& state, const std::string& name, M& m, Eige
 }  // namespace
 
 // After a remesh, checkpoints hold the mesh: remesh.count, remesh.offset (the interface
-// displacement at the last remesh), remesh.nodes (column-major), remesh.triangles,
+// displacement at the last remesh), remesh.quality, remesh.size (the target size per vertex), remesh.nodes (column-major), remesh.triangles,
 // remesh.edge_nodes (row-major), remesh.vertex_count, remesh.groups (names, one a line) and per
 // group remesh.boundary.NAME and remesh.midpoints.NAME.
 void NavierStokesFluid::save_remeshed(StateArchive& state) const {
@@ -570,6 +572,7 @@ void NavierStokesFluid::save_remeshed(StateArchive& state) const {
   state.put("remesh.count", static_cast<std::int64_t>(remeshes_));
   state.put("remesh.offset", remesh_offset_);
   state.put("remesh.quality", remesh_quality_);
+  state.put("remesh.size", remesh_size_);
   state.put("remesh.nodes", Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(m.nodes.data(), m.nodes.size())));
   state.put("remesh.triangles", index_vector(m.triangles.data(), m.triangles.size()));
   state.put("remesh.edge_nodes", index_vector(m.edge_nodes.data(), m.edge_nodes.size()));
@@ -614,6 +617,7 @@ void NavierStokesFluid::load_remeshed(const StateArchive& state) {
   remeshes_ = static_cast<int>(count);
   remesh_offset_ = count > 0 ? state.vector("remesh.offset") : Eigen::VectorXd();
   remesh_quality_ = count > 0 ? state.real("remesh.quality") : 1.0;
+  remesh_size_ = count > 0 ? state.vector("remesh.size") : Eigen::VectorXd();
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {

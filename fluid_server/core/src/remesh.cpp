@@ -1,5 +1,7 @@
 #include "fsi/fluid/remesh.hpp"
 
+#include "fsi/fluid/field_transfer.hpp"
+
 #include <fmt/format.h>
 #include <gmsh.h>
 
@@ -54,7 +56,19 @@ struct GmshSession {
 
 }  // namespace
 
-RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions) {
+Eigen::VectorXd reference_sizes(const FluidMesh& mesh) {
+  const int nv = mesh.vertices();
+  Eigen::VectorXd size = Eigen::VectorXd::Zero(nv), count = Eigen::VectorXd::Zero(nv);
+  for (int e = 0; e < mesh.triangle_count(); ++e) {
+    const double area = std::abs(signed_area(mesh.nodes, mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)));
+    const double h = std::sqrt(4 * area / std::sqrt(3.0));
+    for (int k = 0; k < 3; ++k) size(mesh.triangles(e, k)) += h, count(mesh.triangles(e, k)) += 1;
+  }
+  for (int v = 0; v < nv; ++v) size(v) /= std::max(count(v), 1.0);
+  return size;
+}
+
+RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& vertex_size) {
   const auto t0 = std::chrono::steady_clock::now();
   if (positions.rows() != mesh.node_count()) throw std::invalid_argument("remesh: positions has the wrong size");
   const int nv_old = mesh.vertices();
@@ -68,14 +82,8 @@ RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions) {
   std::vector<int> new_vertex(static_cast<std::size_t>(nv_old), -1);
   for (std::size_t i = 0; i < kept.size(); ++i) new_vertex[static_cast<std::size_t>(kept[i])] = static_cast<int>(i);
 
-  // Local sizes: per old vertex the mean reference size of its triangles.
-  Eigen::VectorXd size = Eigen::VectorXd::Zero(nv_old), count = Eigen::VectorXd::Zero(nv_old);
-  for (int e = 0; e < mesh.triangle_count(); ++e) {
-    const double area = std::abs(signed_area(mesh.nodes, mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)));
-    const double h = std::sqrt(4 * area / std::sqrt(3.0));
-    for (int k = 0; k < 3; ++k) size(mesh.triangles(e, k)) += h, count(mesh.triangles(e, k)) += 1;
-  }
-  for (int v = 0; v < nv_old; ++v) size(v) /= std::max(count(v), 1.0);
+  const Eigen::VectorXd size = vertex_size.size() == 0 ? reference_sizes(mesh) : vertex_size;
+  if (size.size() != nv_old) throw std::invalid_argument("remesh: vertex_size has the wrong size");
 
   // Boundary loops: each kept vertex starts exactly one boundary edge.
   std::vector<int> out_edge(static_cast<std::size_t>(nv_old), -1);
@@ -206,6 +214,11 @@ RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions) {
   }
   result.old_node.assign(static_cast<std::size_t>(nv), -1);
   for (std::size_t i = 0; i < kept.size(); ++i) result.old_node[i] = kept[i];
+  {
+    const MeshLocator locator(mesh, positions);
+    result.vertex_size = interpolate_field(locator, mesh, Eigen::MatrixXd(size), out.nodes).col(0);
+    for (std::size_t i = 0; i < kept.size(); ++i) result.vertex_size(static_cast<Eigen::Index>(i)) = size(kept[i]);
+  }
 
   if (mesh.quadratic()) {
     // Midpoints: the kept boundary ones (old order) first, then the interior edge centres.

@@ -110,6 +110,7 @@ class NavierStokesFluid : public FluidModel {
   FluidMesh original_mesh_;                 // the scene's mesh (checkpoints from before a remesh)
   Eigen::VectorXd remesh_offset_;           // the interface displacement at the last remesh
   double remesh_quality_ = 1.0;             // the quality the last remesh reached
+  Eigen::VectorXd remesh_size_;             // the target size per vertex (the scene mesh's, carried on)
   int remeshes_ = 0;
   double remesh_seconds_ = 0;
   Eigen::VectorXd motion_input(const Eigen::VectorXd& interface_displacement) const;

@@ -23,11 +23,18 @@ namespace fsi::fluid {
 struct RemeshResult {
   FluidMesh mesh;             // its reference positions are the old mesh's current ones
   std::vector<int> old_node;  // per new node: the old node it is (kept boundary nodes), or -1
+  Eigen::VectorXd vertex_size;  // the target size at every new vertex (interpolated from the old one)
   double seconds = 0;         // wall time in gmsh and the renumbering
 };
 
 // `positions`: the old mesh's nodes where they are now (node_count x 2). Throws
 // std::runtime_error when gmsh fails or the new mesh has an inverted triangle.
-RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions);
+// `vertex_size`: the target size at every old vertex (empty: reference_sizes(mesh)); carried
+// from remesh to remesh (interpolated at the new vertices), so repeated remeshes keep the
+// scene's sizes instead of drifting with each mesh's own.
+RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions,
+                    const Eigen::VectorXd& vertex_size = Eigen::VectorXd());
+// Per vertex the mean size sqrt(4 A / sqrt(3)) of its triangles (reference positions).
+Eigen::VectorXd reference_sizes(const FluidMesh& mesh);
 
 }  // namespace fsi::fluid
