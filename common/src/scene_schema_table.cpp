@@ -328,7 +328,7 @@ std::vector<Key> fem_fluid_keys() {
               {
                   boolean("enabled", "remesh when the quality falls below min_quality").def(
                       "true with fluid.interface.groups"),
-                  number("min_quality", "minimum scaled Jacobian that triggers a remesh").def("0.15").lt(1),
+                  number("min_quality", "minimum scaled Jacobian that triggers a remesh").def("0.1").lt(1),
                   number("min_curved_jacobian", "P2: minimum relative curved Jacobian that triggers a remesh")
                       .def("0.3")
                       .only_when(element, {"p2p1"}, "p1p1"),

@@ -95,7 +95,7 @@ class NavierStokesFluid : public FluidModel {
   // Remeshing (fluid.remesh; remesh.hpp).
   struct RemeshSettings {
     bool enabled = false;
-    double min_quality = 0.15;          // remesh when the minimum scaled Jacobian falls below
+    double min_quality = 0.1;           // remesh when the minimum scaled Jacobian falls below
     double min_curved_jacobian = 0.3;  // P2: or the curved Jacobian (relative) below
     std::vector<int> at_steps;          // forced remeshes after these steps (tests)
   } remesh_;
