@@ -735,9 +735,17 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
                                                                    remesh_.min_quality
                                                              : 1.0);
     const bool poor = remesh_.enabled && motion_ && worst < remesh_.min_quality && worst < 0.9 * remesh_quality_;
-    if (forced || poor)
-      remesh(info, forced ? "forced (fluid.remesh.at_steps)"
-                          : fmt::format("quality {:.3g}, curved {:.3g}", q.min_scaled_jacobian, q.min_curved_jacobian));
+    if (forced) {
+      remesh(info, "forced (fluid.remesh.at_steps)");
+    } else if (poor) {
+      try {
+        remesh(info, fmt::format("quality {:.3g}, curved {:.3g}", q.min_scaled_jacobian, q.min_curved_jacobian));
+      } catch (const std::exception& e) {  // the old mesh is still valid: go on with it
+        fsi::logger("fluid")->warn("fluid: remeshing after step {} failed ({}); continuing on the current mesh",
+                                   info.step, e.what());
+        remesh_quality_ = worst;
+      }
+    }
   }
 
   const auto now = std::chrono::steady_clock::now();
