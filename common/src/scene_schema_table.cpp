@@ -324,6 +324,8 @@ std::vector<Key> fem_fluid_keys() {
                       .only_when("groups")
                       .only_when(element, {"p2p1"}, "p1p1"),
               }),
+      text("initial_state", "fluid.state of another run's checkpoint (fsi run --initial-state RUN_DIR): start from "
+                            "its velocity and pressure, interpolated onto this mesh"),
       section("remesh", "remeshing when the moving mesh's quality drops (boundary nodes kept, interior by gmsh)",
               {
                   boolean("enabled", "remesh when the quality falls below min_quality").def(

@@ -554,6 +554,14 @@ TransferReport FlowSolver::transfer_state(const FlowSolver& old, const std::vect
   return report;
 }
 
+void FlowSolver::restart_history() {
+  U_nm1_ = U_ = U_n_;
+  X_nm1_ = X_ = X_n_;
+  dt_n_ = dt_trial_ = 0;
+  accepted_ = trial_solves_ = 0;
+  interface_velocity_.setZero();
+}
+
 Eigen::MatrixX2d FlowSolver::velocity() const {
   Eigen::MatrixX2d v(mesh().node_count(), 2);
   for (int i = 0; i < mesh().node_count(); ++i) v.row(i) << U_(impl_->dof.velocity(i, 0)), U_(impl_->dof.velocity(i, 1));

@@ -339,6 +339,7 @@ void NavierStokesFluid::configure(const ConfigSection& section, const FluidSetup
       fsi::logger("fluid")->warn("boundary group '{}' has no condition: it is a do-nothing boundary", g.first);
   if (!interface_groups.empty()) configure_mesh_motion(section, interface_groups, fixed_groups);
   configure_output(section, params.density);
+  if (section.has("initial_state")) load_initial_state(resolve_path(section, "initial_state"));
 
   fsi::logger("fluid")->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, "
                              "mesh {}", element_, taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(),
@@ -563,7 +564,7 @@ void index_matrix(const StateArchive& state, const std::string& name, M& m, Eige
 }
 }  // namespace
 
-// After a remesh, checkpoints hold the mesh: remesh.count, remesh.offset (the interface
+// Checkpoints hold the current mesh (the scene's until a remesh): remesh.count, remesh.offset (the interface
 // displacement at the last remesh), remesh.quality, remesh.size (the target size per vertex), remesh.nodes (column-major), remesh.triangles,
 // remesh.edge_nodes (row-major), remesh.vertex_count, remesh.groups (names, one a line) and per
 // group remesh.boundary.NAME and remesh.midpoints.NAME.
@@ -594,6 +595,23 @@ void NavierStokesFluid::load_remeshed(const StateArchive& state) {
   if (count == 0 && remeshes_ == 0) return;
   FluidMesh mesh;
   if (count > 0) {
+    mesh = mesh_from_state(state);
+  } else {
+    if (original_mesh_.node_count() == 0) throw std::logic_error("NavierStokesFluid: no scene mesh kept");
+    mesh = original_mesh_;
+  }
+  solver_ = make_solver(std::move(mesh), solver_->parameters());
+  if (motion_) build_mesh_motion();
+  remeshes_ = static_cast<int>(count);
+  remesh_offset_ = count > 0 ? state.vector("remesh.offset") : Eigen::VectorXd();
+  remesh_quality_ = count > 0 ? state.real("remesh.quality") : 1.0;
+  remesh_size_ = count > 0 ? state.vector("remesh.size") : Eigen::VectorXd();
+}
+
+// The mesh a checkpoint holds (remesh.*).
+FluidMesh NavierStokesFluid::mesh_from_state(const StateArchive& state) {
+  FluidMesh mesh;
+  {
     const Eigen::VectorXd nodes = state.vector("remesh.nodes");
     mesh.nodes = Eigen::Map<const Eigen::MatrixX2d>(nodes.data(), nodes.size() / 2, 2);
     index_matrix(state, "remesh.triangles", mesh.triangles, 3);
@@ -608,16 +626,29 @@ void NavierStokesFluid::load_remeshed(const StateArchive& state) {
         mesh.boundary_midpoints[name] = mid.cast<int>();
       }
     }
-  } else {
-    if (original_mesh_.node_count() == 0) throw std::logic_error("NavierStokesFluid: no scene mesh kept");
-    mesh = original_mesh_;
   }
-  solver_ = make_solver(std::move(mesh), solver_->parameters());
-  if (motion_) build_mesh_motion();
-  remeshes_ = static_cast<int>(count);
-  remesh_offset_ = count > 0 ? state.vector("remesh.offset") : Eigen::VectorXd();
-  remesh_quality_ = count > 0 ? state.real("remesh.quality") : 1.0;
-  remesh_size_ = count > 0 ? state.vector("remesh.size") : Eigen::VectorXd();
+  return mesh;
+}
+
+// fluid.initial_state: a fluid.state of another run's checkpoint (fsi run --initial-state
+// RUN_DIR finds the newest): its velocity and pressure, on its mesh where it was (another
+// mesh, another element), interpolated onto this mesh (FlowSolver::transfer_state); the run
+// starts from them with BDF1, a mesh at rest and zero interface velocity.
+void NavierStokesFluid::load_initial_state(const std::filesystem::path& file) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto state = StateArchive::parse(read_text(file), file.string());
+  if (!state.has("remesh.nodes"))
+    throw StateError(fmt::format("{}: the checkpoint holds no fluid mesh (written before checkpoints held it)",
+                                 file.string()));
+  FlowSolver old(mesh_from_state(state), solver_->parameters(), state.text("flow.element"));
+  if (state.vector("flow.interface_velocity").size() > 0) old.set_interface(interface_groups_);
+  old.load_state(state, "flow.");
+  const TransferReport r = solver_->transfer_state(old, std::vector<int>(static_cast<std::size_t>(solver_->mesh().node_count()), -1));
+  solver_->restart_history();
+  fsi::logger("fluid")->info("fluid: initial state from {} ({} on {} nodes): {} of {} points outside its mesh (by <= "
+                             "{:.2e}); {:.3f} s",
+                             file.string(), state.text("flow.element"), old.mesh().node_count(), r.outside, r.points,
+                             r.max_distance, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {
@@ -769,7 +800,7 @@ void NavierStokesFluid::save_state(StateArchive& state) {
   solver_->save_state(state, "flow.");
   if (motion_) motion_->save_state(state, "mesh.");
   state.put("fluid.last_interface_displacement", last_interface_displacement_);
-  if (remeshes_ > 0) save_remeshed(state);
+  save_remeshed(state);  // the current mesh (remeshing, --initial-state)
   state.put("fluid.factorisations", static_cast<std::int64_t>(factorisations_));
   state.put("fluid.solves", static_cast<std::int64_t>(solves_));
 }

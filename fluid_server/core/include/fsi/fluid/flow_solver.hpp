@@ -148,6 +148,9 @@ class FlowSolver {
   // sizes and the interface velocity. The new mesh's reference positions are its current ones.
   // The reactions restart at zero (the next solve makes them). Returns the interpolation report.
   TransferReport transfer_state(const FlowSolver& old, const std::vector<int>& old_node);
+  // A fresh start from the present velocity and pressure (after transfer_state from another
+  // run's state): no history (the next step is BDF1), the mesh at rest, no interface velocity.
+  void restart_history();
 
   // --- results of the last solve ---
   const FluidMesh& mesh() const;

@@ -104,6 +104,8 @@ class NavierStokesFluid : public FluidModel {
   std::unique_ptr<FlowSolver> make_solver(FluidMesh mesh, const FlowParameters& params) const;
   void save_remeshed(StateArchive& state) const;
   void load_remeshed(const StateArchive& state);
+  static FluidMesh mesh_from_state(const StateArchive& state);
+  void load_initial_state(const std::filesystem::path& file);
   std::vector<std::function<void(FlowSolver&)>> conditions_;  // the scene's conditions, for a new solver
   std::vector<std::string> interface_groups_, fixed_groups_;
   MeshMotionOptions motion_options_;
