@@ -263,6 +263,7 @@ Child start_server(Server& s, const fs::path& bin, const std::string& bind, std:
 struct RunOptions {
   std::string scene_path, out_dir, solid_command, fluid_command, curve_keys;
   std::string from;  // --from: a run folder (its newest checkpoint) or one checkpoint folder
+  std::string initial_state;  // --initial-state: the same, for the fluid's fields only
   std::vector<std::string> overrides;
   double timeout = 600;
   bool resume = false, force = false;
@@ -606,6 +607,10 @@ int run(const RunOptions& given) {
     if (!overrides) return 0;
     o.overrides = *overrides;
   }
+  // --initial-state DIR: the fluid starts from the fields of DIR's checkpoint (fluid.initial_state).
+  if (!o.initial_state.empty())
+    o.overrides.push_back("fluid.initial_state=" +
+                          fs::absolute(fork_checkpoint(o.initial_state).dir / "fluid.state").string());
   // Every key of every section against the scene schema, before anything starts (fsi check);
   // the sections an external solver reads are its own business.
   std::vector<std::string> external;
@@ -694,6 +699,10 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
                       "start from a checkpoint of another run (its folder: the newest checkpoint; or one "
                       "checkpoints/step_N folder) with this scene and --set changes, into a new --out (the "
                       "original is not touched; summary.json lists the changed keys)");
+  run_cmd->add_option("--initial-state", o.initial_state,
+                      "start the fluid from the velocity and pressure of another run's checkpoint (its folder: the "
+                      "newest; or one checkpoints/step_N folder), interpolated onto this run's mesh (another mesh or "
+                      "element is fine); sets fluid.initial_state");
   run_cmd->add_option("--recover", o.recover,
                       "restart a server that dies or stops answering up to N times, resuming from the last "
                       "checkpoint (default: 3 when time.checkpoint_every > 0, else 0)");

@@ -60,6 +60,9 @@ RUN = {
     # The checkpoint holds time.end = 0.6: --resume alone finds the run complete (nothing to do).
     "build/bin/fsi run configs/thick_beam.yaml --out runs/tb --resume": None,
     "build/bin/fsi run configs/thick_beam.yaml --out runs/tb --resume --set time.end=4": ("append", "--set time.end=0.8"),
+    # docs/fluid.md: a forced remesh of the steady DFG 2D-1 (a coarser mesh here).
+    "build/bin/fsi run configs/dfg_2d1_p2p1.yaml --out runs/d21_remesh --set time.end=2 --set 'fluid.remesh.at_steps=[1]'":
+        ("append", "--set fluid.mesh.size=0.08 --set fluid.mesh.parameters.hc=0.01"),
     "build/bin/fsi study studies/thin_beam.yaml --out runs/study_thin --jobs 2":
         ("append", "--set time.end=0.01 --quiet"),
     "build/bin/fsi study studies/thick_beam.yaml --out runs/study_thick --jobs 2": ("append", "--set time.end=0.04 --quiet"),
@@ -126,6 +129,18 @@ SKIP = {
     "coupling.algorithm=1 --set coupling.iterations.tolerance=0 --set \"coupling.iterations.measures=[{quantity: traction, "
     "type: relative, limit: 1.0e-4}]\"": "benchmark: the fork of the FSI2 run above to t = 9.1, about 7 minutes",
     "bench/fsi/run_turek_hron.sh fsi3 runs/fsi3": "benchmark: Turek-Hron FSI3, 895 s",
+    # docs/fluid.md (remeshing) and docs/paper_examples.md (the thin beam with remeshing).
+    "build/bin/fsi run configs/dfg_2d2_p2p1.yaml --out runs/d22 --set time.end=7": "benchmark: DFG 2D-2 to t = 7, 433 s",
+    "build/bin/fsi run configs/dfg_2d2_p2p1.yaml --out runs/d22_remesh --set time.end=7 --set 'fluid.remesh.at_steps=[2500]'":
+        "benchmark: DFG 2D-2 to t = 7 with a remesh, 263 s",
+    "/usr/bin/python3 bench/fluid/periodic_stats.py runs/d22/probes.csv --columns cd cl --window 1.0 --strouhal-scale 0.1":
+        "statistics of the DFG 2D-2 benchmark run",
+    "build/bin/fsi run configs/thin_beam.yaml --out runs/thin_a1 --set coupling.iterations.max=2":
+        "benchmark: the thin beam to t = 3, about 70 s",
+    "build/bin/fsi run configs/thin_beam.yaml --out runs/thin_a2_gG --set coupling.algorithm=2 --set "
+    "coupling.iterations.max=2 --set coupling.gamma_n1=G": "synopsis (G = 10, 100, 1000): benchmarks of up to 2 minutes",
+    "/usr/bin/python3 bench/fsi/thin_beam_remesh_plot.py docs/img/thin_beam_A_x_remesh.png \"Algorithm 1, gamma "
+    "100=runs/thin_a1\" \"Algorithm 2, gamma 10=runs/thin_a2_g10\" ...": "synopsis; reads the thin-beam runs (benchmarks)",
     "bench/fsi/run_turek_hron.sh fsi2 runs/fsi2": "benchmark: Turek-Hron FSI2, 708 s",
     FSI3_B: "benchmark: FSI3 to t = 3.5",
     "/usr/bin/python3 bench/fsi/th_stats.py fsi3 runs/fsi3_B --periods 4 --plot docs/img/fsi_fsi3.png":

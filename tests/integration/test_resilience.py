@@ -158,6 +158,10 @@ RESUME_CASES = {
                                             "filter_type: qr3, preconditioner: residual-sum}",
                                             "coupling.iterations={max: 8, tolerance: 1.0e-4, stop_if_not_converged: false}"],
                         27, 240),
+    # Remeshing (fluid.remesh.at_steps): the checkpoint of step 20 holds the mesh of the remesh
+    # after step 15; the resumed run makes the remesh after step 25 itself.
+    "thick_beam_remesh": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10",
+                                              "fluid.remesh.at_steps=[15, 25]"], 27, 240),
 }
 
 
@@ -206,6 +210,14 @@ def resume_small(env):
 def resume_thick_beam(env):
     resume_case(env, "thick_beam", "kill -9 coupler")
     resume_case(env, "thick_beam_imvj", "SIGINT")
+
+
+def resume_remesh(env):
+    resume_case(env, "thick_beam_remesh", "SIGINT")
+    log = open(os.path.join(env.out("thick_beam_remesh_cut"), "fluid_server.log")).read()
+    assert "remesh 2 at step 25" in log, log[-2000:]
+    s = summary(env.out("thick_beam_remesh_cut"))
+    assert s["wall_time"]["fluid_breakdown"]["remeshes"] == 2, s["wall_time"]["fluid_breakdown"]
 
 
 def resume_fsi3(env):
@@ -536,5 +548,6 @@ def vtk_output(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fsi3, resume_refused, fork, recover_kill,
-                                  recover_kill_fenics, recover_stop, recover_gives_up, exit_paths, coupler_death, orphan_servers, vtk_output)})
+    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_refused, fork,
+                                  recover_kill, recover_kill_fenics, recover_stop, recover_gives_up, exit_paths,
+                                  coupler_death, orphan_servers, vtk_output)})

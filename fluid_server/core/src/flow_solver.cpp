@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "fsi/common/solver_model.hpp"
+#include "fsi/fluid/field_transfer.hpp"
 #include "fsi/fluid/sparse_lu.hpp"
 #include "flow_element.hpp"
 
@@ -502,6 +503,63 @@ void FlowSolver::load_state(const StateArchive& state, const std::string& prefix
   accepted_ = static_cast<int>(accepted);
   trial_solves_ = static_cast<int>(trial);
   impl_->lu->load_state(state, prefix + "lu.");
+}
+
+TransferReport FlowSolver::transfer_state(const FlowSolver& old, const std::vector<int>& old_node) {
+  const auto& om = old.mesh();
+  const auto& nm = mesh();
+  const auto& od = old.impl_->dof;
+  const auto& nd = impl_->dof;
+  if (old_node.size() != static_cast<std::size_t>(nm.node_count()))
+    throw std::invalid_argument("FlowSolver::transfer_state: old_node has the wrong size");
+  // Old nodal fields: u_n, u_{n-1} (2 + 2 columns) and x_n - x_{n-1} (2) per node; p_n, p_{n-1} per vertex.
+  const int on = om.node_count(), ov = om.vertices();
+  Eigen::MatrixXd nodal(on, 6), vertex(ov, 2);
+  for (int i = 0; i < on; ++i)
+    for (int c = 0; c < 2; ++c) {
+      nodal(i, c) = old.U_n_(od.velocity(i, c));
+      nodal(i, 2 + c) = old.U_nm1_(od.velocity(i, c));
+      nodal(i, 4 + c) = old.X_n_(i, c) - old.X_nm1_(i, c);
+    }
+  for (int v = 0; v < ov; ++v) vertex(v, 0) = old.U_n_(od.pressure(v)), vertex(v, 1) = old.U_nm1_(od.pressure(v));
+  const MeshLocator locator(om, old.X_n_);
+  TransferReport report;
+  Eigen::MatrixXd at_nodes = interpolate_field(locator, om, nodal, nm.nodes, &report);
+  Eigen::MatrixXd at_vertices = interpolate_field(locator, om, vertex, nm.nodes.topRows(nm.vertices()));
+  // Kept nodes: their own values, not an interpolation.
+  for (int i = 0; i < nm.node_count(); ++i)
+    if (const int o = old_node[static_cast<std::size_t>(i)]; o >= 0) {
+      at_nodes.row(i) = nodal.row(o);
+      if (i < nm.vertices()) {
+        if (o >= ov) throw std::invalid_argument("FlowSolver::transfer_state: a vertex kept as a midpoint");
+        at_vertices.row(i) = vertex.row(o);
+      }
+    }
+  U_n_ = U_nm1_ = Eigen::VectorXd::Zero(nd.dofs);
+  for (int i = 0; i < nm.node_count(); ++i)
+    for (int c = 0; c < 2; ++c) {
+      U_n_(nd.velocity(i, c)) = at_nodes(i, c);
+      U_nm1_(nd.velocity(i, c)) = at_nodes(i, 2 + c);
+    }
+  for (int v = 0; v < nm.vertices(); ++v) U_n_(nd.pressure(v)) = at_vertices(v, 0), U_nm1_(nd.pressure(v)) = at_vertices(v, 1);
+  U_ = U_n_;
+  reaction_ = Eigen::VectorXd::Zero(nd.dofs);
+  X_ = X_n_ = nm.nodes;
+  X_nm1_ = nm.nodes - at_nodes.rightCols<2>();
+  dt_n_ = old.dt_n_;
+  dt_trial_ = old.dt_trial_;
+  accepted_ = old.accepted_;
+  trial_solves_ = 0;
+  if (interface_velocity_.size() == old.interface_velocity_.size()) interface_velocity_ = old.interface_velocity_;
+  return report;
+}
+
+void FlowSolver::restart_history() {
+  U_nm1_ = U_ = U_n_;
+  X_nm1_ = X_ = X_n_;
+  dt_n_ = dt_trial_ = 0;
+  accepted_ = trial_solves_ = 0;
+  interface_velocity_.setZero();
 }
 
 Eigen::MatrixX2d FlowSolver::velocity() const {

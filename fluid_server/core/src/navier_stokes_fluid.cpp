@@ -14,7 +14,9 @@
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/scene_reader.hpp"
+#include "fsi/fluid/field_transfer.hpp"
 #include "fsi/fluid/mesh_quality.hpp"
+#include "fsi/fluid/remesh.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -286,6 +288,8 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
   read_stabilisation(section, taylor_hood, params.stabilisation);
   read_linear_solver(section, taylor_hood, params);
   const auto interface_groups = read_nitsche(section, setup, params);
+  read_remesh(section, !interface_groups.empty());
+  if (remesh_.enabled || !remesh_.at_steps.empty()) original_mesh_ = mesh;  // a checkpoint before the first remesh
   solver_ = std::make_unique<FlowSolver>(std::move(mesh), params, element_);
   const auto& fluid_mesh = solver_->mesh();
 
@@ -296,6 +300,7 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
       fsi::logger("fluid")->warn("boundary group '{}' has no condition: it is a do-nothing boundary", g.first);
   if (!interface_groups.empty()) configure_mesh_motion(section, interface_groups, fixed_groups);
   configure_output(section, params.density);
+  if (section.has("initial_state")) load_initial_state(section.path("initial_state"));
 
   fsi::logger("fluid")->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, "
                              "mesh {}", element_, taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(),
@@ -307,9 +312,20 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
 // fluid.inflow, walls, moving_walls, symmetry, outlet and pressure_reference on the solver.
 // Returns the groups with a condition (the mesh motion holds them fixed).
 std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema::Reader& section, const std::string& msh) {
-  auto& solver = *solver_;
-  const auto& mesh = solver.mesh();
+  const auto& mesh = solver_->mesh();
   std::vector<std::string> fixed;
+  // Each condition is kept, to set it on the solver of a new mesh (remeshing).
+  struct Recorder {
+    NavierStokesFluid& self;
+    void add_dirichlet(const std::string& g, VelocityFunction f) {
+      self.conditions_.push_back([g, f](FlowSolver& s) { s.add_dirichlet(g, f); });
+    }
+    void add_symmetry(const std::string& g) { self.conditions_.push_back([g](FlowSolver& s) { s.add_symmetry(g); }); }
+    void set_pressure_reference(const Eigen::Vector2d& p, std::function<double(double)> v) {
+      self.conditions_.push_back([p, v](FlowSolver& s) { s.set_pressure_reference(p, v); });
+    }
+  } solver{*this};
+  conditions_.clear();
   for (const auto& inflow : section.list("inflow")) {
     const auto group = inflow.get<std::string>("group");
     fixed.push_back(group);
@@ -339,6 +355,7 @@ std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema
   }
   if (auto pr = section.optional_child("pressure_reference"))
     solver.set_pressure_reference(vector2(*pr, "point"), [v = pr->get<double>("value")](double) { return v; });
+  for (const auto& c : conditions_) c(*solver_);
   return fixed;
 }
 
@@ -350,8 +367,10 @@ void NavierStokesFluid::configure_mesh_motion(const schema::Reader& section, con
   const auto iface = section.child("interface");
   for (const auto& g : groups)
     if (!fluid_mesh.has_boundary(g)) iface.fail("groups", "no boundary group '" + g + "'");
+  interface_groups_ = groups;
+  fixed_groups_ = fixed_groups;
   solver_->set_interface(groups);
-  MeshMotionOptions motion;
+  MeshMotionOptions& motion = motion_options_;
   motion.stiffening = iface.get<double>("mesh_stiffening");
   if (iface.get<std::string>("mesh_motion") == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
   motion.incremental = iface.get<bool>("mesh_incremental");
@@ -361,6 +380,13 @@ void NavierStokesFluid::configure_mesh_motion(const schema::Reader& section, con
   // the 4-triangle refinement of every element (every node extended; 4x the unknowns).
   const auto on = fluid_mesh.quadratic() ? iface.get<std::string>("mesh_motion_nodes") : "all";
   motion_on_vertices_ = fluid_mesh.quadratic() && on == "vertices";
+  build_mesh_motion();
+}
+
+// The extension on the solver's current mesh (its reference positions), from the options read.
+void NavierStokesFluid::build_mesh_motion() {
+  const auto& fluid_mesh = solver_->mesh();
+  const auto& fixed_groups = fixed_groups_;
   std::vector<int> moving = solver_->interface_nodes(), fixed = fluid_mesh.boundary_nodes(fixed_groups);
   if (motion_on_vertices_) {
     const int nv = fluid_mesh.vertices();
@@ -379,7 +405,7 @@ void NavierStokesFluid::configure_mesh_motion(const schema::Reader& section, con
   } else {
     motion_mesh_ = fluid_mesh.linear_refinement();
   }
-  motion_ = std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion);  // keeps a pointer to motion_mesh_
+  motion_ = std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion_options_);  // keeps a pointer to motion_mesh_
 }
 
 // Force probes, pressure probes and differences, VTK (fluid.forces, pressure_probes,
@@ -417,6 +443,167 @@ void NavierStokesFluid::configure_output(const schema::Reader& section, double d
     vtk_every_ = out->get_or<int>("vtk_every", -1);
   }
   if (vtk_every_ != 0 && !setup_.output_dir.empty()) vtk_ = PvdSeries(setup_.output_dir, "fluid", setup_.vtk_format);
+}
+
+// fluid.remesh: {enabled (default: with an interface), min_quality, min_curved_jacobian, at_steps}.
+void NavierStokesFluid::read_remesh(const schema::Reader& section, bool moving) {
+  const auto rm = section.child_or_defaults("remesh");
+  remesh_.enabled = rm.get_or<bool>("enabled", moving);
+  remesh_.min_quality = rm.get<double>("min_quality");
+  remesh_.min_curved_jacobian = rm.get<double>("min_curved_jacobian");
+  remesh_.at_steps = rm.get_or<std::vector<int>>("at_steps", {});
+  if (remesh_.enabled && !moving) rm.fail("enabled", "the quality trigger needs a moving mesh (fluid.interface.groups)");
+}
+
+// Replaces the solver by one on a new mesh of the current (accepted) domain, keeping every
+// boundary node (remesh.hpp), with the state interpolated (FlowSolver::transfer_state); the
+// mesh motion restarts from the new mesh, whose reference positions are the current ones.
+void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const FlowSolver& old = *solver_;
+  const MeshQuality before = mesh_quality(old.mesh(), old.accepted_positions());
+  if (remesh_size_.size() == 0) remesh_size_ = reference_sizes(old.mesh());
+  RemeshResult r = fluid::remesh(old.mesh(), old.accepted_positions(), remesh_size_);
+  auto fresh = make_solver(std::move(r.mesh), old.parameters());
+  const auto &oi = old.interface_nodes(), &ni = fresh->interface_nodes();
+  bool same = oi.size() == ni.size();
+  for (std::size_t k = 0; same && k < ni.size(); ++k) same = r.old_node[static_cast<std::size_t>(ni[k])] == oi[k];
+  if (!same)
+    throw SolverError(fmt::format("step {}: remeshing changed the interface nodes ({} -> {}); the coupler's mapping "
+                                  "would not fit", info.step, oi.size(), ni.size()));
+  const TransferReport transfer = fresh->transfer_state(old, r.old_node);
+  if (motion_ && last_interface_displacement_.size() > 0) {
+    if (remesh_offset_.size() != last_interface_displacement_.size())
+      remesh_offset_ = Eigen::VectorXd::Zero(last_interface_displacement_.size());
+    remesh_offset_ += last_interface_displacement_;
+    last_interface_displacement_.setZero();
+  }
+  const int old_nodes = old.mesh().node_count();
+  solver_ = std::move(fresh);
+  remesh_size_ = std::move(r.vertex_size);
+  if (motion_) build_mesh_motion();
+  const MeshQuality after = mesh_quality(solver_->mesh(), solver_->mesh().nodes);
+  remesh_quality_ = std::min(after.min_scaled_jacobian, solver_->mesh().quadratic() ? after.min_curved_jacobian / remesh_.min_curved_jacobian * remesh_.min_quality : 1.0);
+  ++remeshes_;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  remesh_seconds_ += seconds;
+  fsi::logger("fluid")->info("fluid: remesh {} at step {} (t = {:.6g}; {}): {} -> {} nodes, scaled Jacobian {:.3g} -> "
+                             "{:.3g}, max angle {:.1f} -> {:.1f} deg; {} of {} points outside the old mesh (by <= "
+                             "{:.2e}); {:.3f} s ({:.3f} s in gmsh)",
+                             remeshes_, info.step, info.time, why, old_nodes, solver_->mesh().node_count(),
+                             before.min_scaled_jacobian, after.min_scaled_jacobian, before.max_angle_deg,
+                             after.max_angle_deg, transfer.outside, transfer.points, transfer.max_distance, seconds,
+                             r.seconds);
+}
+
+// A solver on `mesh` with the scene's conditions and interface.
+std::unique_ptr<FlowSolver> NavierStokesFluid::make_solver(FluidMesh mesh, const FlowParameters& params) const {
+  auto s = std::make_unique<FlowSolver>(std::move(mesh), params, element_);
+  for (const auto& c : conditions_) c(*s);
+  if (!interface_groups_.empty()) s->set_interface(interface_groups_);
+  return s;
+}
+
+namespace {
+Eigen::VectorXd index_vector(const int* data, Eigen::Index n) {
+  Eigen::VectorXd v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v(i) = data[i];
+  return v;
+}
+template <class M>
+void index_matrix(const StateArchive& state, const std::string& name, M& m, Eigen::Index cols) {
+  const Eigen::VectorXd v = state.vector(name);
+  if (v.size() % cols != 0) throw StateError(fmt::format("entry '{}' has {} values, not a multiple of {}", name, v.size(), cols));
+  m.resize(v.size() / cols, cols);
+  for (Eigen::Index i = 0; i < v.size(); ++i) m.data()[i] = static_cast<int>(v(i));
+}
+}  // namespace
+
+// Checkpoints hold the current mesh (the scene's until a remesh): remesh.count, remesh.offset (the interface
+// displacement at the last remesh), remesh.quality, remesh.size (the target size per vertex), remesh.nodes (column-major), remesh.triangles,
+// remesh.edge_nodes (row-major), remesh.vertex_count, remesh.groups (names, one a line) and per
+// group remesh.boundary.NAME and remesh.midpoints.NAME.
+void NavierStokesFluid::save_remeshed(StateArchive& state) const {
+  const auto& m = solver_->mesh();
+  state.put("remesh.count", static_cast<std::int64_t>(remeshes_));
+  state.put("remesh.offset", remesh_offset_);
+  state.put("remesh.quality", remesh_quality_);
+  state.put("remesh.size", remesh_size_);
+  state.put("remesh.nodes", Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(m.nodes.data(), m.nodes.size())));
+  state.put("remesh.triangles", index_vector(m.triangles.data(), m.triangles.size()));
+  state.put("remesh.edge_nodes", index_vector(m.edge_nodes.data(), m.edge_nodes.size()));
+  state.put("remesh.vertex_count", static_cast<std::int64_t>(m.vertex_count));
+  std::string groups;
+  for (const auto& [name, seg] : m.boundaries) {
+    groups += name + "\n";
+    state.put("remesh.boundary." + name, index_vector(seg.data(), seg.size()));
+    if (const auto it = m.boundary_midpoints.find(name); it != m.boundary_midpoints.end())
+      state.put("remesh.midpoints." + name, index_vector(it->second.data(), it->second.size()));
+  }
+  state.put("remesh.groups", groups);
+}
+
+// The mesh of a checkpoint: a remeshed one (remesh.*), or the scene's when this model has
+// remeshed since; the solver and the mesh motion are rebuilt on it before their states load.
+void NavierStokesFluid::load_remeshed(const StateArchive& state) {
+  const std::int64_t count = state.has("remesh.count") ? state.integer("remesh.count") : 0;
+  if (count == 0 && remeshes_ == 0) return;
+  FluidMesh mesh;
+  if (count > 0) {
+    mesh = mesh_from_state(state);
+  } else {
+    if (original_mesh_.node_count() == 0) throw std::logic_error("NavierStokesFluid: no scene mesh kept");
+    mesh = original_mesh_;
+  }
+  solver_ = make_solver(std::move(mesh), solver_->parameters());
+  if (motion_) build_mesh_motion();
+  remeshes_ = static_cast<int>(count);
+  remesh_offset_ = count > 0 ? state.vector("remesh.offset") : Eigen::VectorXd();
+  remesh_quality_ = count > 0 ? state.real("remesh.quality") : 1.0;
+  remesh_size_ = count > 0 ? state.vector("remesh.size") : Eigen::VectorXd();
+}
+
+// The mesh a checkpoint holds (remesh.*).
+FluidMesh NavierStokesFluid::mesh_from_state(const StateArchive& state) {
+  FluidMesh mesh;
+  {
+    const Eigen::VectorXd nodes = state.vector("remesh.nodes");
+    mesh.nodes = Eigen::Map<const Eigen::MatrixX2d>(nodes.data(), nodes.size() / 2, 2);
+    index_matrix(state, "remesh.triangles", mesh.triangles, 3);
+    index_matrix(state, "remesh.edge_nodes", mesh.edge_nodes, 3);
+    mesh.vertex_count = static_cast<int>(state.integer("remesh.vertex_count"));
+    std::istringstream groups(state.text("remesh.groups"));
+    for (std::string name; std::getline(groups, name);) {
+      if (name.empty()) continue;
+      index_matrix(state, "remesh.boundary." + name, mesh.boundaries[name], 2);
+      if (mesh.quadratic()) {
+        const Eigen::VectorXd mid = state.vector("remesh.midpoints." + name);
+        mesh.boundary_midpoints[name] = mid.cast<int>();
+      }
+    }
+  }
+  return mesh;
+}
+
+// fluid.initial_state: a fluid.state of another run's checkpoint (fsi run --initial-state
+// RUN_DIR finds the newest): its velocity and pressure, on its mesh where it was (another
+// mesh, another element), interpolated onto this mesh (FlowSolver::transfer_state); the run
+// starts from them with BDF1, a mesh at rest and zero interface velocity.
+void NavierStokesFluid::load_initial_state(const std::filesystem::path& file) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto state = StateArchive::parse(read_text(file), file.string());
+  if (!state.has("remesh.nodes"))
+    throw StateError(fmt::format("{}: the checkpoint holds no fluid mesh (written before checkpoints held it)",
+                                 file.string()));
+  FlowSolver old(mesh_from_state(state), solver_->parameters(), state.text("flow.element"));
+  if (state.vector("flow.interface_velocity").size() > 0) old.set_interface(interface_groups_);
+  old.load_state(state, "flow.");
+  const TransferReport r = solver_->transfer_state(old, std::vector<int>(static_cast<std::size_t>(solver_->mesh().node_count()), -1));
+  solver_->restart_history();
+  fsi::logger("fluid")->info("fluid: initial state from {} ({} on {} nodes): {} of {} points outside its mesh (by <= "
+                             "{:.2e}); {:.3f} s",
+                             file.string(), state.text("flow.element"), old.mesh().node_count(), r.outside, r.points,
+                             r.max_distance, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {
@@ -466,8 +653,12 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   const auto t0 = std::chrono::steady_clock::now();
   Eigen::MatrixX2d positions = solver_->mesh().nodes;
   if (motion_ && interface_displacement.size() > 0) {
-    positions += extend(interface_displacement);
-    last_interface_displacement_ = interface_displacement;
+    // After a remesh the reference is the mesh of the remesh: the displacement from there.
+    const Eigen::VectorXd d = remesh_offset_.size() == interface_displacement.size()
+                                  ? Eigen::VectorXd(interface_displacement - remesh_offset_)
+                                  : interface_displacement;
+    positions += extend(d);
+    last_interface_displacement_ = d;
   }
   try {
     last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
@@ -513,11 +704,34 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
   probes["nonlinear_iterations"] = last_report_.iterations;
   probes["nonlinear_change"] = last_report_.change;
   probes["factorisations"] = factorisations_;
+  MeshQuality q;
   if (motion_) {  // the moving mesh's quality (fsi/fluid/mesh_quality.hpp)
-    const MeshQuality q = mesh_quality(solver_->mesh(), solver_->accepted_positions());
+    q = mesh_quality(solver_->mesh(), solver_->accepted_positions());
     probes["mesh_min_scaled_jacobian"] = q.min_scaled_jacobian;
     probes["mesh_max_angle"] = q.max_angle_deg;
     if (solver_->mesh().quadratic()) probes["mesh_min_curved_jacobian"] = q.min_curved_jacobian;
+  }
+  // Remeshing (after the probes: they are the step's, on the mesh it was solved on).
+  if (remesh_.enabled || !remesh_.at_steps.empty()) {
+    const bool forced = std::find(remesh_.at_steps.begin(), remesh_.at_steps.end(), info.step) != remesh_.at_steps.end();
+    // Below the threshold, and below what the last remesh reached (a remesh that could not
+    // reach the threshold, e.g. at a sharp boundary corner, is not repeated every step).
+    const double worst = std::min(q.min_scaled_jacobian, solver_->mesh().quadratic()
+                                                             ? q.min_curved_jacobian / remesh_.min_curved_jacobian *
+                                                                   remesh_.min_quality
+                                                             : 1.0);
+    const bool poor = remesh_.enabled && motion_ && worst < remesh_.min_quality && worst < 0.9 * remesh_quality_;
+    if (forced) {
+      remesh(info, "forced (fluid.remesh.at_steps)");
+    } else if (poor) {
+      try {
+        remesh(info, fmt::format("quality {:.3g}, curved {:.3g}", q.min_scaled_jacobian, q.min_curved_jacobian));
+      } catch (const std::exception& e) {  // the old mesh is still valid: go on with it
+        fsi::logger("fluid")->warn("fluid: remeshing after step {} failed ({}); continuing on the current mesh",
+                                   info.step, e.what());
+        remesh_quality_ = worst;
+      }
+    }
   }
 
   const auto now = std::chrono::steady_clock::now();
@@ -541,6 +755,7 @@ void NavierStokesFluid::save_state(StateArchive& state) {
   solver_->save_state(state, "flow.");
   if (motion_) motion_->save_state(state, "mesh.");
   state.put("fluid.last_interface_displacement", last_interface_displacement_);
+  save_remeshed(state);  // the current mesh (remeshing, --initial-state)
   state.put("fluid.factorisations", static_cast<std::int64_t>(factorisations_));
   state.put("fluid.solves", static_cast<std::int64_t>(solves_));
 }
@@ -549,6 +764,7 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
   if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
   if (const auto saved = state.text("flow.element"); saved != element_)
     throw StateError(fmt::format("entry 'flow.element' is '{}', this configuration uses fluid.element {}", saved, element_));
+  load_remeshed(state);  // the state's mesh (the scene's, or a remeshed one)
   if (!motion_ && state.has("mesh.base_displacement"))
     throw StateError("entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
   const Eigen::VectorXd last = state.vector("fluid.last_interface_displacement");

@@ -93,6 +93,18 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                       .only_when("groups")
                       .only_when(element, {"p2p1"}, "p1p1"),
               }),
+      text("initial_state", "fluid.state of another run's checkpoint (fsi run --initial-state RUN_DIR): start from "
+                            "its velocity and pressure, interpolated onto this mesh"),
+      section("remesh", "remeshing when the moving mesh's quality drops (boundary nodes kept, interior by gmsh)",
+              {
+                  boolean("enabled", "remesh when the quality falls below min_quality")
+                      .def_computed("true with fluid.interface.groups"),
+                  number("min_quality", "minimum scaled Jacobian that triggers a remesh").def("0.1").lt(1),
+                  number("min_curved_jacobian", "P2: minimum relative curved Jacobian that triggers a remesh")
+                      .def("0.3")
+                      .only_when(element, {"p2p1"}, "p1p1"),
+                  int_list("at_steps", 0, "remesh after these steps in any case (tests)"),
+              }),
       section_list("inflow", "velocity inlets",
                    {
                        text("group", "boundary group").req(),

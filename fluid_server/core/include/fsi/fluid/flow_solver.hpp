@@ -32,6 +32,8 @@
 
 namespace fsi::fluid {
 
+struct TransferReport;  // field_transfer.hpp
+
 using VelocityFunction = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
 
 enum class TimeScheme { Steady, BDF1, BDF2 };
@@ -136,6 +138,19 @@ class FlowSolver {
   // solve: continues bit for bit as the saved one. fsi::StateError (naming the entry) when
   // the state does not fit (another element or mesh); the solver is then unchanged.
   void load_state(const StateArchive& state, const std::string& prefix);
+  // Remeshing (remesh.hpp): this solver, set up on a new mesh of the same domain with the old
+  // one's conditions and interface and not yet stepped, takes the accepted state of `old`:
+  // velocity and pressure of the last two accepted steps (the BDF history) and the last
+  // step's mesh displacement x_n - x_{n-1} (so the BDF mesh velocity carries over),
+  // interpolated with the old element's own shape functions at the new nodes
+  // (field_transfer.hpp; P2 velocity and P1 pressure for P2/P1, P1 for P1/P1), copied at the
+  // nodes `old_node` names (the kept boundary nodes: -1 = a new node); the step counts and
+  // sizes and the interface velocity. The new mesh's reference positions are its current ones.
+  // The reactions restart at zero (the next solve makes them). Returns the interpolation report.
+  TransferReport transfer_state(const FlowSolver& old, const std::vector<int>& old_node);
+  // A fresh start from the present velocity and pressure (after transfer_state from another
+  // run's state): no history (the next step is BDF1), the mesh at rest, no interface velocity.
+  void restart_history();
 
   // --- results of the last solve ---
   const FluidMesh& mesh() const;

@@ -6,6 +6,7 @@
 //
 // Call order (fsi::FluidModel): configure -> interface -> {solve_step ... accept_step} -> write_output.
 #include <chrono>
+#include <functional>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -67,8 +68,11 @@ class NavierStokesFluid : public FluidModel {
   // Cumulative seconds: "mesh_motion" (extension), "assembly", "factorisation", "linear_solve"
   // (triangular solves and Krylov iterations), "step" (all of them, per solve call).
   std::map<std::string, double> timings() const override {
-    return {{"mesh_motion", motion_ ? motion_->seconds() : 0.0}, {"assembly", assembly_seconds_},
-            {"factorisation", factor_seconds_}, {"linear_solve", linear_solve_seconds_}, {"step", solve_seconds_}};
+    std::map<std::string, double> t{{"mesh_motion", motion_ ? motion_->seconds() : 0.0}, {"assembly", assembly_seconds_},
+                                    {"factorisation", factor_seconds_}, {"linear_solve", linear_solve_seconds_},
+                                    {"step", solve_seconds_}};
+    if (remeshes_ > 0) t["remesh"] = remesh_seconds_, t["remeshes"] = remeshes_;  // "remeshes": a count
+    return t;
   }
   // Unknowns, mesh nodes and triangles (summary.json of standalone runs).
   std::map<std::string, double> sizes() const override {
@@ -95,6 +99,30 @@ class NavierStokesFluid : public FluidModel {
   void configure_mesh_motion(const schema::Reader& section, const std::vector<std::string>& groups,
                              const std::vector<std::string>& fixed_groups);
   void configure_output(const schema::Reader& section, double density);
+  void build_mesh_motion();
+  // Remeshing (fluid.remesh; remesh.hpp).
+  struct RemeshSettings {
+    bool enabled = false;
+    double min_quality = 0.1;           // remesh when the minimum scaled Jacobian falls below
+    double min_curved_jacobian = 0.3;  // P2: or the curved Jacobian (relative) below
+    std::vector<int> at_steps;          // forced remeshes after these steps (tests)
+  } remesh_;
+  void read_remesh(const schema::Reader& section, bool moving);
+  void remesh(const StepInfo& info, const std::string& why);
+  std::unique_ptr<FlowSolver> make_solver(FluidMesh mesh, const FlowParameters& params) const;
+  void save_remeshed(StateArchive& state) const;
+  void load_remeshed(const StateArchive& state);
+  static FluidMesh mesh_from_state(const StateArchive& state);
+  void load_initial_state(const std::filesystem::path& file);
+  std::vector<std::function<void(FlowSolver&)>> conditions_;  // the scene's conditions, for a new solver
+  std::vector<std::string> interface_groups_, fixed_groups_;
+  MeshMotionOptions motion_options_;
+  FluidMesh original_mesh_;                 // the scene's mesh (checkpoints from before a remesh)
+  Eigen::VectorXd remesh_offset_;           // the interface displacement at the last remesh
+  double remesh_quality_ = 1.0;             // the quality the last remesh reached
+  Eigen::VectorXd remesh_size_;             // the target size per vertex (the scene mesh's, carried on)
+  int remeshes_ = 0;
+  double remesh_seconds_ = 0;
   Eigen::VectorXd motion_input(const Eigen::VectorXd& interface_displacement) const;
   Eigen::MatrixX2d extend(const Eigen::VectorXd& interface_displacement) const;  // every node
   std::unique_ptr<MeshMotion> motion_;
