@@ -273,24 +273,24 @@ struct RunOptions {
 
 // --from PATH: the checkpoint folder (PATH itself when it holds a manifest.json, else the
 // newest complete one under PATH/checkpoints), checked as the coupler checks it.
-fsi::coupling::CheckpointStore::Loaded fork_checkpoint(const std::string& from) {
+fsi::coupling::CheckpointStore::Loaded fork_checkpoint(const std::string& from, const std::string& option = "--from") {
   const fs::path p(from);
   if (fs::exists(p / "manifest.json")) {
     try {
       return fsi::coupling::CheckpointStore::read(p);
     } catch (const std::exception& e) {
-      throw fsi::ConfigError(fmt::format("--from '{}': not a complete checkpoint ({})", from, e.what()));
+      throw fsi::ConfigError(fmt::format("{} '{}': not a complete checkpoint ({})", option, from, e.what()));
     }
   }
   const fs::path dir = p / "checkpoints";
   if (!fs::is_directory(dir))
-    throw fsi::ConfigError(fmt::format("--from '{}': neither a checkpoint (no manifest.json) nor a run folder with "
+    throw fsi::ConfigError(fmt::format("{} '{}': neither a checkpoint (no manifest.json) nor a run folder with "
                                        "checkpoints/ (time.checkpoint_every > 0)",
-                                       from));
+                                       option, from));
   std::vector<std::string> skipped;
   auto found = fsi::coupling::CheckpointStore(dir, 1).newest(&skipped);
   if (!found)
-    throw fsi::ConfigError(fmt::format("--from '{}': no complete checkpoint in {}{}", from, dir.string(),
+    throw fsi::ConfigError(fmt::format("{} '{}': no complete checkpoint in {}{}", option, from, dir.string(),
                                        skipped.empty() ? std::string() : " (" + skipped.front() + ")"));
   return *found;
 }
@@ -610,7 +610,7 @@ int run(const RunOptions& given) {
   // --initial-state DIR: the fluid starts from the fields of DIR's checkpoint (fluid.initial_state).
   if (!o.initial_state.empty())
     o.overrides.push_back("fluid.initial_state=" +
-                          fs::absolute(fork_checkpoint(o.initial_state).dir / "fluid.state").string());
+                          fs::absolute(fork_checkpoint(o.initial_state, "--initial-state").dir / "fluid.state").string());
   // Every key of every section against the scene schema, before anything starts (fsi check);
   // the sections an external solver reads are its own business.
   std::vector<std::string> external;
