@@ -24,8 +24,8 @@
 namespace {
 
 // The launcher's view: every section declared.
-const bool kDeclared = (fsi::coupling::coupling_section(), fsi::models::solid_section(), fsi::models::fluid_section(),
-                        true);
+const bool kDeclared =
+    (fsi::coupling::coupling_section(), fsi::models::solid_section(), fsi::models::fluid_section(), true);
 
 template <class F>
 void expect_config_errors_only(const char* what, F&& f) {
@@ -85,7 +85,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::vector<std::string> overrides(parts.begin() + 1, parts.end());
 
   std::vector<fsi::Scene> scene;  // 0 or 1
-  expect_config_errors_only("Scene::parse", [&] { scene.push_back(fsi::Scene::parse(text, "fuzz/scene.yaml", overrides)); });
+  expect_config_errors_only("Scene::parse",
+                            [&] { scene.push_back(fsi::Scene::parse(text, "fuzz/scene.yaml", overrides)); });
   if (scene.empty()) return 0;
   const fsi::Scene& s = scene[0];
   expect_config_errors_only("Scene::name", [&] { (void)s.name(); });
@@ -102,6 +103,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     expect_config_errors_only("section", [&] { read_model_section(s.section(name)); });
   expect_config_errors_only("check_all_used", [&] { s.check_all_used(); });
   expect_config_errors_only("schema::check_scene", [&] { (void)fsi::schema::check_scene(s); });
-  expect_config_errors_only("schema::require_valid", [&] { fsi::schema::require_valid(s, {"time", "coupling", "solid", "fluid"}); });
+  expect_config_errors_only("schema::require_valid", [&] {
+    fsi::schema::require_valid(s, {"time", "coupling", "solid", "fluid"});
+  });
   return 0;
 }

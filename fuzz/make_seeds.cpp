@@ -144,7 +144,8 @@ std::vector<std::string> fluid_sequence(const std::string& scene) {
   const int n = itf.interface().node_ids_size();
   {
     auto r = base(0);
-    for (int i = 0; i < 2 * n; ++i) r.mutable_initial_loads()->add_interface_displacement(0), r.mutable_initial_loads()->add_interface_velocity(0);
+    for (int i = 0; i < 2 * n; ++i)
+      r.mutable_initial_loads()->add_interface_displacement(0), r.mutable_initial_loads()->add_interface_velocity(0);
     b.send(r);
   }
   std::string state;
@@ -185,7 +186,8 @@ const char* kSdof = R"(solid:
 std::string fem(const std::string& extra, const std::string& elements = "[4, 1]") {
   return "solid:\n  model: fem\n  mesh: {type: rectangle, origin: [0, 0], size: [1.0, 0.2], elements: " + elements +
          "}\n  material: {law: neo_hookean, youngs_modulus: 1.0e4, poisson_ratio: 0.3}\n  density: 10.0\n"
-         "  clamp: left\n  interface: [top, right, bottom]\n" + extra;
+         "  clamp: left\n  interface: [top, right, bottom]\n" +
+         extra;
 }
 
 const char* kSurrogate = R"(fluid:
@@ -212,14 +214,18 @@ int main(int argc, char** argv) {
   write(solid, "seed_fem_bdf2_damping",
         solid_sequence(fem("  time_scheme: bdf2\n  linear_solver: umfpack\n  gravity: [0, -2]\n"), 5.0));
   write(solid, "seed_fem_static",
-        solid_sequence(fem("  analysis: static\n  load_steps: 2\n  newton: {max_iterations: 8, residual_tolerance: 1.0e-8}\n"
-                           "  tractions: [{boundary: top, traction: [0, -1]}]\n  point_loads: [{point: [1, 0.2], force: [0, -0.1]}]\n",
-                           "[3, 2]"),
-                       0.0, false));
-  write(solid, "seed_fem_svk", solid_sequence(
-      "solid:\n  model: fem\n  mesh: {type: rectangle, origin: [0, 0], size: [0.35, 0.02], elements: [5, 1]}\n"
-      "  material: {law: saint_venant_kirchhoff, shear_modulus: 5.0e5, poisson_ratio: 0.4}\n  density: 1000\n"
-      "  time_scheme: bdf1\n  clamp: [left]\n  interface: [top, bottom, right]\n  output_every: 2\n", 0.0));
+        solid_sequence(
+            fem("  analysis: static\n  load_steps: 2\n  newton: {max_iterations: 8, residual_tolerance: 1.0e-8}\n"
+                "  tractions: [{boundary: top, traction: [0, -1]}]\n  point_loads: [{point: [1, 0.2], force: [0, "
+                "-0.1]}]\n",
+                "[3, 2]"),
+            0.0, false));
+  write(solid, "seed_fem_svk",
+        solid_sequence(
+            "solid:\n  model: fem\n  mesh: {type: rectangle, origin: [0, 0], size: [0.35, 0.02], elements: [5, 1]}\n"
+            "  material: {law: saint_venant_kirchhoff, shear_modulus: 5.0e5, poisson_ratio: 0.4}\n  density: 1000\n"
+            "  time_scheme: bdf1\n  clamp: [left]\n  interface: [top, bottom, right]\n  output_every: 2\n",
+            0.0));
   {  // out of order and invalid requests
     fsi::protocol::SolidService service(fsi::models::make_solid_model, "seed");
     Builder b{service, {}};

@@ -64,9 +64,7 @@ inline YAML::Node lookup(const YAML::Node& map, const std::string& key) {
   return YAML::Node(YAML::NodeType::Undefined);
 }
 
-inline std::string scalar(const YAML::Node& node) {
-  return node && node.IsScalar() ? node.Scalar() : std::string();
-}
+inline std::string scalar(const YAML::Node& node) { return node && node.IsScalar() ? node.Scalar() : std::string(); }
 
 // Parses the Configure's scene as the service will (same text, overrides) and returns the
 // section it will configure from, or an undefined node when the scene does not parse (the

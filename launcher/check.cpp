@@ -42,9 +42,9 @@ struct StudyKey {
 };
 
 struct Study {
-  std::string file;          // the study file as given
-  fs::path scene;            // resolved
-  std::string scene_where;   // where `scene` is written
+  std::string file;         // the study file as given
+  fs::path scene;           // resolved
+  std::string scene_where;  // where `scene` is written
   std::vector<StudyKey> fixed, varied, derived;
 };
 
@@ -108,9 +108,10 @@ void read_study(const fs::path& path, const std::string& shown, Study& study, in
         break;
       }
     if (study.scene.empty())
-      throw ConfigError(fmt::format("{}: scene '{}' not found (relative to the study, the working folder or the "
-                                    "source tree)",
-                                    study.scene_where, given.string()));
+      throw ConfigError(
+          fmt::format("{}: scene '{}' not found (relative to the study, the working folder or the "
+                      "source tree)",
+                      study.scene_where, given.string()));
     // A path as the user sees it: relative to the working folder when below it.
     const auto relative = fs::relative(study.scene);
     if (!relative.empty() && relative.native().rfind("..", 0) != 0) study.scene = relative;
@@ -119,9 +120,9 @@ void read_study(const fs::path& path, const std::string& shown, Study& study, in
     std::vector<StudyKey> keys;
     flatten(fixed, "", shown, keys);
     for (auto& k : keys) {  // a key of this file replaces the parent's
-      study.fixed.erase(std::remove_if(study.fixed.begin(), study.fixed.end(),
-                                       [&](const StudyKey& f) { return f.key == k.key; }),
-                        study.fixed.end());
+      study.fixed.erase(
+          std::remove_if(study.fixed.begin(), study.fixed.end(), [&](const StudyKey& f) { return f.key == k.key; }),
+          study.fixed.end());
       study.fixed.push_back(k);
     }
   }
@@ -170,8 +171,8 @@ int check_study(const std::string& file, const std::vector<std::string>& cli_ove
   for (const auto& d : study.derived) keys.push_back({d.key, YAML::Node("1"), d.where, d.where});
   for (const auto& k : keys) {
     if (!scene_key(k.key)) continue;
-    const bool derived = std::any_of(study.derived.begin(), study.derived.end(),
-                                     [&](const StudyKey& d) { return d.where == k.where; });
+    const bool derived =
+        std::any_of(study.derived.begin(), study.derived.end(), [&](const StudyKey& d) { return d.where == k.where; });
     auto with = overrides;
     with.push_back(k.key + "=" + emit(k.value));
     auto opts = options;
@@ -179,7 +180,7 @@ int check_study(const std::string& file, const std::vector<std::string>& cli_ove
     for (auto p : schema::check_scene(Scene::load(study.scene, with), opts).problems) {
       if (p.where != k.where) continue;
       const bool name = p.message.rfind("unknown", 0) == 0 || p.message.find("is only used") != std::string::npos;
-      if (derived && !name) continue;  // a derived value is an expression: only its name is checked here
+      if (derived && !name) continue;   // a derived value is an expression: only its name is checked here
       if (name) p.where = k.key_where;  // a problem of the key, not of one of its values
       if (seen.insert(p.text()).second) problems.push_back(p);
     }

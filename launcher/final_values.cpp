@@ -8,9 +8,8 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
-#include <vector>
-
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "fsi/common/history_stats.hpp"
 #include "fsi/common/log.hpp"
@@ -51,8 +50,8 @@ void report_final_values(const fs::path& out) {
     }
     std::size_t width = 0;
     for (const auto& [name, s] : shown) width = std::max(width, name.size());
-    std::string text = fmt::format("final values at t = {:.6g} ({} steps; statistics in summary.json):\n", time->back(),
-                                   time->size());
+    std::string text =
+        fmt::format("final values at t = {:.6g} ({} steps; statistics in summary.json):\n", time->back(), time->size());
     for (const auto& [name, s] : shown)
       text += fmt::format("  {:<{}}  {:>13.6g}  {}\n", name, width, s.final_value, describe(s));
     if (const auto* its = table.column("coupling.iterations"); its && !its->empty()) {
@@ -103,8 +102,8 @@ int plot_folder(const fs::path& folder, const std::string& python, const fs::pat
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     execvp(argv[0], argv.data());
-    std::fprintf(stderr, "cannot start %s (set FSI_PYTHON to a python3 with numpy and matplotlib): %s\n",
-                 argv[0], std::strerror(errno));
+    std::fprintf(stderr, "cannot start %s (set FSI_PYTHON to a python3 with numpy and matplotlib): %s\n", argv[0],
+                 std::strerror(errno));
     _exit(127);
   }
   int status = 0;

@@ -12,32 +12,30 @@
 // Exit codes: 0 completed, 2 diverged, 1 failed (bad input or options, a dead peer that could
 // not be recovered, a crashed coupler), 130 interrupted (SIGINT / SIGTERM). Every way a run
 // ends leaves summary.json with its final status.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
-#include <cstring>
-#include <map>
-#include <optional>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
-#include <algorithm>
-
+#include "check.hpp"
+#include "final_values.hpp"
 #include "fsi/common/config.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
-#include "check.hpp"
-#include "final_values.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/version.hpp"
@@ -80,7 +78,7 @@ Child spawn(const std::string& name, const std::vector<std::string>& argv, const
     // one BLAS thread each, unless the user says otherwise (TOOLCHAIN.md, docs/fluid.md).
     setenv("OMP_WAIT_POLICY", "passive", 0);
     setenv("OPENBLAS_NUM_THREADS", "1", 0);
-    setpgid(0, 0);                     // own process group: Ctrl-C goes through the launcher
+    setpgid(0, 0);  // own process group: Ctrl-C goes through the launcher
     if (!log.empty()) {
       // Appended: a resumed or recovered run keeps its earlier segments' logs (a fresh run's
       // folder has none, --force removes them).
@@ -176,15 +174,24 @@ fs::path self_dir() { return fs::read_symlink("/proc/self/exe").parent_path(); }
 
 const char* signal_name(int sig) {
   switch (sig) {
-    case SIGINT: return "SIGINT";
-    case SIGTERM: return "SIGTERM";
-    case SIGKILL: return "SIGKILL";
-    case SIGSEGV: return "SIGSEGV";
-    case SIGABRT: return "SIGABRT";
-    case SIGBUS: return "SIGBUS";
-    case SIGFPE: return "SIGFPE";
-    case SIGHUP: return "SIGHUP";
-    default: return "a signal";
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGKILL:
+      return "SIGKILL";
+    case SIGSEGV:
+      return "SIGSEGV";
+    case SIGABRT:
+      return "SIGABRT";
+    case SIGBUS:
+      return "SIGBUS";
+    case SIGFPE:
+      return "SIGFPE";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "a signal";
   }
 }
 
@@ -262,13 +269,13 @@ Child start_server(Server& s, const fs::path& bin, const std::string& bind, std:
 
 struct RunOptions {
   std::string scene_path, out_dir, solid_command, fluid_command, curve_keys;
-  std::string from;  // --from: a run folder (its newest checkpoint) or one checkpoint folder
+  std::string from;           // --from: a run folder (its newest checkpoint) or one checkpoint folder
   std::string initial_state;  // --initial-state: the same, for the fluid's fields only
   std::vector<std::string> overrides;
   double timeout = 600;
   bool resume = false, force = false;
   bool plot = false;  // --plot: tools/fsi_plot.py on --out at the end
-  int recover = -1;  // -1: 3 when checkpoints are on, else 0
+  int recover = -1;   // -1: 3 when checkpoints are on, else 0
 };
 
 // --from PATH: the checkpoint folder (PATH itself when it holds a manifest.json, else the
@@ -284,9 +291,10 @@ fsi::coupling::CheckpointStore::Loaded fork_checkpoint(const std::string& from, 
   }
   const fs::path dir = p / "checkpoints";
   if (!fs::is_directory(dir))
-    throw fsi::ConfigError(fmt::format("{} '{}': neither a checkpoint (no manifest.json) nor a run folder with "
-                                       "checkpoints/ (time.checkpoint_every > 0)",
-                                       option, from));
+    throw fsi::ConfigError(
+        fmt::format("{} '{}': neither a checkpoint (no manifest.json) nor a run folder with "
+                    "checkpoints/ (time.checkpoint_every > 0)",
+                    option, from));
   std::vector<std::string> skipped;
   auto found = fsi::coupling::CheckpointStore(dir, 1).newest(&skipped);
   if (!found)
@@ -392,9 +400,18 @@ void start_servers(const RunOptions& o, const fs::path& ports, CoupledProcesses&
 // The coupler's command line (a later attempt resumes, or restarts when there is nothing to resume).
 std::vector<std::string> coupler_command(const RunOptions& o, const CoupledProcesses& p, bool resume, int attempts,
                                          int recover, const std::vector<std::string>& sets) {
-  std::vector<std::string> argv{(self_dir() / "coupler").string(), o.scene_path, "--solid", p.servers[0].endpoint,
-                                "--fluid", p.servers[1].endpoint, "--out", o.out_dir, "--timeout",
-                                fmt::format("{}", o.timeout), "--connect-timeout", std::to_string(kHelloWaitSeconds),
+  std::vector<std::string> argv{(self_dir() / "coupler").string(),
+                                o.scene_path,
+                                "--solid",
+                                p.servers[0].endpoint,
+                                "--fluid",
+                                p.servers[1].endpoint,
+                                "--out",
+                                o.out_dir,
+                                "--timeout",
+                                fmt::format("{}", o.timeout),
+                                "--connect-timeout",
+                                std::to_string(kHelloWaitSeconds),
                                 "--out-ready"};
   if (resume) argv.push_back("--resume");
   if (resume && attempts > 0) argv.push_back("--resume-or-restart");
@@ -423,8 +440,8 @@ void recover_server(const fs::path& out, CoupledProcesses& p, std::size_t i, nlo
   const nlohmann::json checkpoint = newest_checkpoint(out);
   const int from = checkpoint.is_object() ? checkpoint.value("step", 0) : 0;
   const double restart_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double recompute = lost.value("wall_seconds", 0.0) -
-                           (checkpoint.is_object() ? checkpoint.value("wall_seconds", 0.0) : 0.0);
+  const double recompute =
+      lost.value("wall_seconds", 0.0) - (checkpoint.is_object() ? checkpoint.value("wall_seconds", 0.0) : 0.0);
   nlohmann::json j = summary.is_object() ? summary : nlohmann::json::object();
   auto& recoveries = j["recoveries"];
   if (!recoveries.is_array()) recoveries = nlohmann::json::array();
@@ -475,9 +492,10 @@ void after_coupler(CoupledProcesses& p, Ending& e) {
   if (e.code > 128 && e.code != 130) {
     // The coupler itself died: say so at once, stop both servers together.
     e.status = "failed";
-    e.reason = fmt::format("the coupler was killed by {} ({}); `fsi run ... --resume` continues from the last "
-                           "checkpoint",
-                           signal_name(e.code - 128), e.code - 128);
+    e.reason = fmt::format(
+        "the coupler was killed by {} ({}); `fsi run ... --resume` continues from the last "
+        "checkpoint",
+        signal_name(e.code - 128), e.code - 128);
     log->error("{}", e.reason);
     stop_all({&p.children[0], &p.children[1]}, std::chrono::milliseconds(0), std::chrono::milliseconds(400));
     e.code = 1;
@@ -496,8 +514,8 @@ void say_how_to_resume(const RunOptions& o, const fs::path& out) {
   const auto quote = [](const std::string& a) {
     return a.find_first_of(" '\"$\\") == std::string::npos ? a : "'" + a + "'";
   };
-  fsi::logger("fsi")->info("continue it with: {} run {} --out {} --resume", quote(fs::read_symlink("/proc/self/exe").string()),
-                           quote(o.scene_path), quote(o.out_dir));
+  fsi::logger("fsi")->info("continue it with: {} run {} --out {} --resume",
+                           quote(fs::read_symlink("/proc/self/exe").string()), quote(o.scene_path), quote(o.out_dir));
 }
 
 // Coupled: two servers and the coupler; with --recover, a server that dies or stops
@@ -554,17 +572,20 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
                : "the run wrote no checkpoints (time.checkpoint_every: 0), so it cannot be continued; run it again "
                  "into another --out, or with --force");
   std::vector<std::string> overrides;
-  for (const auto& ov : ckpt->manifest.value("overrides", nlohmann::json::array())) overrides.push_back(ov.get<std::string>());
+  for (const auto& ov : ckpt->manifest.value("overrides", nlohmann::json::array()))
+    overrides.push_back(ov.get<std::string>());
   overrides.insert(overrides.end(), o.overrides.begin(), o.overrides.end());
   const auto scene = fsi::Scene::load(o.scene_path, overrides);
   if (!scene.has("coupling")) refuse("only coupled runs write checkpoints");
   std::vector<std::string> differ;
   bool extended = false;
   const double end = fsi::read_time(scene).end;
-  for (const auto& d : fsi::coupling::parameter_differences(ckpt->manifest.value("parameters", nlohmann::json::object()),
-                                                            fsi::scene_to_json(scene))) {
-    if (d.rfind("time.end:", 0) == 0) extended = true;
-    else differ.push_back(d);
+  for (const auto& d : fsi::coupling::parameter_differences(
+           ckpt->manifest.value("parameters", nlohmann::json::object()), fsi::scene_to_json(scene))) {
+    if (d.rfind("time.end:", 0) == 0)
+      extended = true;
+    else
+      differ.push_back(d);
   }
   if (!differ.empty()) {
     std::string list;
@@ -576,9 +597,10 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
     refuse(fmt::format("time.end = {} is before the newest checkpoint (t = {})", end, ckpt->time));
   const auto summary = read_json(out / "summary.json");
   if (summary.is_object() && summary.value("status", std::string()) == "completed" && !extended) {
-    fsi::logger("fsi")->info("--resume '{}': the run is complete (t = {}), nothing to do; to extend it: --resume --set "
-                             "time.end=T",
-                             o.out_dir, end);
+    fsi::logger("fsi")->info(
+        "--resume '{}': the run is complete (t = {}), nothing to do; to extend it: --resume --set "
+        "time.end=T",
+        o.out_dir, end);
     return std::nullopt;
   }
   if (extended)
@@ -609,8 +631,9 @@ int run(const RunOptions& given) {
   }
   // --initial-state DIR: the fluid starts from the fields of DIR's checkpoint (fluid.initial_state).
   if (!o.initial_state.empty())
-    o.overrides.push_back("fluid.initial_state=" +
-                          fs::absolute(fork_checkpoint(o.initial_state, "--initial-state").dir / "fluid.state").string());
+    o.overrides.push_back(
+        "fluid.initial_state=" +
+        fs::absolute(fork_checkpoint(o.initial_state, "--initial-state").dir / "fluid.state").string());
   // Every key of every section against the scene schema, before anything starts (fsi check);
   // the sections an external solver reads are its own business.
   std::vector<std::string> external;
@@ -623,8 +646,9 @@ int run(const RunOptions& given) {
   const auto scene = fsi::Scene::load(o.scene_path, o.overrides);  // fails early on a bad file
   const bool coupled = scene.has("coupling");
   const fs::path out(o.out_dir);
-  fsi::prepare_output_dir(out, o.resume ? fsi::OutputMode::Resume : o.force ? fsi::OutputMode::Force
-                                                                           : fsi::OutputMode::Fresh);
+  fsi::prepare_output_dir(out, o.resume  ? fsi::OutputMode::Resume
+                               : o.force ? fsi::OutputMode::Force
+                                         : fsi::OutputMode::Fresh);
   if (!o.from.empty()) {
     if (!coupled) throw fsi::ConfigError("--from: only coupled runs have checkpoints to start from");
     prepare_fork(o.from, out);
@@ -688,9 +712,10 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
   run_cmd->add_option("--solid-command", o.solid_command,
                       "start this external solid instead of solid_server (gets --bind and --port-file)");
   run_cmd->add_option("--fluid-command", o.fluid_command, "start this external fluid instead of fluid_server");
-  run_cmd->add_option("--timeout", o.timeout,
-                      "seconds the coupler waits for any single reply (a server that does not answer within it "
-                      "counts as failed; a dead one is noticed at once)")
+  run_cmd
+      ->add_option("--timeout", o.timeout,
+                   "seconds the coupler waits for any single reply (a server that does not answer within it "
+                   "counts as failed; a dead one is noticed at once)")
       ->capture_default_str();
   run_cmd->add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
   run_cmd->add_flag("--force", o.force, "replace the results of an earlier run in --out");
@@ -706,8 +731,9 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
   run_cmd->add_option("--recover", o.recover,
                       "restart a server that dies or stops answering up to N times, resuming from the last "
                       "checkpoint (default: 3 when time.checkpoint_every > 0, else 0)");
-  run_cmd->add_option("--curve-keys", o.curve_keys,
-                      "encrypt and authenticate the connections with ZeroMQ CURVE, keys from `fsi keys DIR`")
+  run_cmd
+      ->add_option("--curve-keys", o.curve_keys,
+                   "encrypt and authenticate the connections with ZeroMQ CURVE, keys from `fsi keys DIR`")
       ->check(CLI::ExistingDirectory);
   return run_cmd;
 }
@@ -719,9 +745,10 @@ struct CheckOptions {
 };
 
 CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
-  auto* check_cmd = app.add_subcommand(
-      "check", "check a scene (or a study's scene with its fixed and varied keys) against the scene schema, "
-               "without meshing or starting a solver: fsi check SCENE|STUDY [--set key=value ...]");
+  auto* check_cmd =
+      app.add_subcommand("check",
+                         "check a scene (or a study's scene with its fixed and varied keys) against the scene schema, "
+                         "without meshing or starting a solver: fsi check SCENE|STUDY [--set key=value ...]");
   check_cmd->add_option("file", c.file, "scene (configs/*.yaml) or study (studies/*.yaml)");
   check_cmd->add_option("--set", c.overrides, "override any scene key: dotted.key=value (repeatable)");
   check_cmd->add_flag("--reference", c.reference,
@@ -788,21 +815,22 @@ int main(int argc, char** argv) {
   auto* keys_cmd = app.add_subcommand(
       "keys", "write a new CURVE key folder for servers and coupler that talk beyond loopback (proto/README.md)");
   std::string keys_dir;
-  keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")
-      ->required();
+  keys_cmd->add_option("folder", keys_dir, "folder to create (server.key[_secret], coupler.key[_secret])")->required();
   CheckOptions check_options;
   auto* check_cmd = add_check_command(app, check_options);
   std::string plot_dir;
   auto* plot_cmd = app.add_subcommand(
-      "plot", "draw the pictures of a run folder (probe histories with their final statistics; Turek-Hron "
-              "FSI1-3 against the reference) or of a study folder (its maps, work-precision, histories), as PNG "
-              "files into that folder, with the Python the build found ($FSI_PYTHON overrides it)");
+      "plot",
+      "draw the pictures of a run folder (probe histories with their final statistics; Turek-Hron "
+      "FSI1-3 against the reference) or of a study folder (its maps, work-precision, histories), as PNG "
+      "files into that folder, with the Python the build found ($FSI_PYTHON overrides it)");
   plot_cmd->add_option("folder", plot_dir, "a run folder (fsi run --out) or a study folder (fsi study --out)")
       ->required()
       ->check(CLI::ExistingDirectory);
-  auto* study_cmd = app.add_subcommand(
-      "study", "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
-               "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
+  auto* study_cmd =
+      app.add_subcommand("study",
+                         "run a parameter study: fsi study STUDY.yaml --out DIR [--jobs N] [...] (docs/studies.md; "
+                         "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
   study_cmd->allow_extras();
   study_cmd->prefix_command();
   try {

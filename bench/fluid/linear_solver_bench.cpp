@@ -13,11 +13,11 @@
 //
 // Every repetition runs every solver once, interleaved, in this process (so that the load of
 // other processes on the machine hits all of them alike); the tables give medians.
+#include <petscksp.h>
+
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
 #include <Eigen/UmfPackSupport>
-#include <petscksp.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -40,9 +40,9 @@ using SpMat = Eigen::SparseMatrix<double>;
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-#define PCHK(expr)                                                                                  \
-  do {                                                                                              \
-    const PetscErrorCode ierr_ = (expr);                                                            \
+#define PCHK(expr)                                                                                           \
+  do {                                                                                                       \
+    const PetscErrorCode ierr_ = (expr);                                                                     \
     if (ierr_) throw std::runtime_error(std::string("PETSc error ") + std::to_string(ierr_) + " in " #expr); \
   } while (0)
 
@@ -72,10 +72,22 @@ void configure(Umf& lu) {
 class FrozenLu {
  public:
   void set(const Umf* lu) { lu_ = lu; }
-  template <class M> FrozenLu& analyzePattern(const M&) { return *this; }
-  template <class M> FrozenLu& factorize(const M&) { return *this; }
-  template <class M> FrozenLu& compute(const M&) { return *this; }
-  template <class R> Eigen::VectorXd solve(const Eigen::MatrixBase<R>& b) const { return lu_->solve(b); }
+  template <class M>
+  FrozenLu& analyzePattern(const M&) {
+    return *this;
+  }
+  template <class M>
+  FrozenLu& factorize(const M&) {
+    return *this;
+  }
+  template <class M>
+  FrozenLu& compute(const M&) {
+    return *this;
+  }
+  template <class R>
+  Eigen::VectorXd solve(const Eigen::MatrixBase<R>& b) const {
+    return lu_->solve(b);
+  }
   Eigen::ComputationInfo info() const { return Eigen::Success; }
 
  private:
@@ -207,13 +219,16 @@ std::string fmt_double(double v) {
 }
 
 std::vector<PetscConfig> petsc_configs(double rtol) {
-  const std::string outer =
-      "-ksp_type fgmres -ksp_gmres_restart 200 -ksp_rtol " + fmt_double(rtol) + " -ksp_atol 1e-50 -ksp_max_it 1000 "
-      "-pc_type fieldsplit -pc_fieldsplit_type schur -pc_fieldsplit_schur_precondition selfp ";
-  const std::string u_amg = "-fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type hypre -fieldsplit_u_pc_hypre_type boomeramg ";
-  const std::string p_amg = "-fieldsplit_p_ksp_type preonly -fieldsplit_p_pc_type hypre -fieldsplit_p_pc_hypre_type boomeramg ";
-  const std::string hmis = "-pc_hypre_boomeramg_coarsen_type HMIS -pc_hypre_boomeramg_interp_type ext+i "
-                           "-pc_hypre_boomeramg_P_max 4 ";
+  const std::string outer = "-ksp_type fgmres -ksp_gmres_restart 200 -ksp_rtol " + fmt_double(rtol) +
+                            " -ksp_atol 1e-50 -ksp_max_it 1000 "
+                            "-pc_type fieldsplit -pc_fieldsplit_type schur -pc_fieldsplit_schur_precondition selfp ";
+  const std::string u_amg =
+      "-fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type hypre -fieldsplit_u_pc_hypre_type boomeramg ";
+  const std::string p_amg =
+      "-fieldsplit_p_ksp_type preonly -fieldsplit_p_pc_type hypre -fieldsplit_p_pc_hypre_type boomeramg ";
+  const std::string hmis =
+      "-pc_hypre_boomeramg_coarsen_type HMIS -pc_hypre_boomeramg_interp_type ext+i "
+      "-pc_hypre_boomeramg_P_max 4 ";
   return {
       {"full_amg", "FGMRES, Schur full, u: 1 AMG V-cycle, S(selfp): 1 AMG V-cycle",
        outer + "-pc_fieldsplit_schur_fact_type full " + u_amg + p_amg},
@@ -226,18 +241,23 @@ std::vector<PetscConfig> petsc_configs(double rtol) {
        outer + "-pc_fieldsplit_schur_fact_type upper " + u_amg + prefixed("fieldsplit_u_", hmis) + p_amg +
            prefixed("fieldsplit_p_", hmis)},
       {"upper_ilu", "FGMRES, Schur upper, u: ILU(0), S(selfp): 1 AMG V-cycle",
-       outer + "-pc_fieldsplit_schur_fact_type upper -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type ilu " + p_amg},
+       outer + "-pc_fieldsplit_schur_fact_type upper -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type ilu " +
+           p_amg},
       {"upper_sor", "FGMRES, Schur upper, u: 1 SSOR sweep, S(selfp): 1 AMG V-cycle",
-       outer + "-pc_fieldsplit_schur_fact_type upper -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type sor "
-               "-fieldsplit_u_pc_sor_symmetric " + p_amg},
+       outer +
+           "-pc_fieldsplit_schur_fact_type upper -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type sor "
+           "-fieldsplit_u_pc_sor_symmetric " +
+           p_amg},
       {"full_ilu", "FGMRES, Schur full, u: ILU(0), S(selfp): 1 AMG V-cycle",
        outer + "-pc_fieldsplit_schur_fact_type full -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type ilu " + p_amg},
       {"upper_asm", "FGMRES, Schur upper, u: ASM 8 blocks overlap 1 + ILU(0), S(selfp): 1 AMG V-cycle",
-       outer + "-pc_fieldsplit_schur_fact_type upper -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type asm "
-               "-fieldsplit_u_pc_asm_blocks 8 -fieldsplit_u_pc_asm_overlap 1 -fieldsplit_u_sub_pc_type ilu " +
+       outer +
+           "-pc_fieldsplit_schur_fact_type upper -fieldsplit_u_ksp_type preonly -fieldsplit_u_pc_type asm "
+           "-fieldsplit_u_pc_asm_blocks 8 -fieldsplit_u_pc_asm_overlap 1 -fieldsplit_u_sub_pc_type ilu " +
            p_amg},
       {"upper_amg_cc", "FGMRES, Schur upper, u: 1 AMG V-cycle, S: AMG(selfp)^-1 + mu M_p^-1 (Cahouet-Chabard, lumped)",
-       outer + "-pc_fieldsplit_schur_fact_type upper " + u_amg + "-fieldsplit_p_ksp_type preonly -fieldsplit_p_pc_type shell ",
+       outer + "-pc_fieldsplit_schur_fact_type upper " + u_amg +
+           "-fieldsplit_p_ksp_type preonly -fieldsplit_p_pc_type shell ",
        true},
   };
 }
@@ -375,27 +395,42 @@ int run(int argc, char** argv) {
       if (i + 1 >= argc) throw std::runtime_error("missing value after " + a);
       return argv[++i];
     };
-    if (a == "--h") h = std::stod(next());
-    else if (a == "--hc") hc = std::stod(next());
-    else if (a == "--steps") steps = std::stoi(next());
-    else if (a == "--dt") dt = std::stod(next());
-    else if (a == "--reps") reps = std::stoi(next());
-    else if (a == "--lags") lags = parse_ints(next());
-    else if (a == "--ramp") ramp = std::stod(next());
-    else if (a == "--configs") selected = parse_names(next());
-    else if (a == "--rtol") rtol = std::stod(next());
-    else if (a == "--bicgstab-tol") bicg_tol = std::stod(next());
-    else if (a == "--lag-config") lag_config = next();
-    else if (a == "--zero-guess") zero_guess = true;
-    else if (a == "--cache") cache = next();
-    else if (a.rfind("--", 0) == 0) throw std::runtime_error("unknown option " + a);
+    if (a == "--h")
+      h = std::stod(next());
+    else if (a == "--hc")
+      hc = std::stod(next());
+    else if (a == "--steps")
+      steps = std::stoi(next());
+    else if (a == "--dt")
+      dt = std::stod(next());
+    else if (a == "--reps")
+      reps = std::stoi(next());
+    else if (a == "--lags")
+      lags = parse_ints(next());
+    else if (a == "--ramp")
+      ramp = std::stod(next());
+    else if (a == "--configs")
+      selected = parse_names(next());
+    else if (a == "--rtol")
+      rtol = std::stod(next());
+    else if (a == "--bicgstab-tol")
+      bicg_tol = std::stod(next());
+    else if (a == "--lag-config")
+      lag_config = next();
+    else if (a == "--zero-guess")
+      zero_guess = true;
+    else if (a == "--cache")
+      cache = next();
+    else if (a.rfind("--", 0) == 0)
+      throw std::runtime_error("unknown option " + a);
     // single-dash options belong to PETSc
   }
   for (int lag : lags)
     if (lag < 1 || lag >= steps) throw std::runtime_error("every lag must be in [1, steps - 1]");
 
   // 1. Mesh and solver: DFG 2D-2 with Taylor-Hood, as configs/dfg_2d2_p2p1.yaml.
-  const auto msh = fsi::fluid::mesh_geo(FSI_SOURCE_DIR "/configs/meshes/dfg_cylinder.geo", {{"h", h}, {"hc", hc}}, cache, 2);
+  const auto msh =
+      fsi::fluid::mesh_geo(FSI_SOURCE_DIR "/configs/meshes/dfg_cylinder.geo", {{"h", h}, {"hc", hc}}, cache, 2);
   const auto mesh = fsi::fluid::FluidMesh::from_gmsh(fsi::read_gmsh(msh));
   fsi::fluid::FlowParameters p;
   p.density = 1.0;
@@ -419,8 +454,8 @@ int run(int argc, char** argv) {
   solver.add_dirichlet("cylinder", zero);
   const int n = solver.mesh().node_count(), nv = solver.mesh().vertices();
   const int N = solver.dofs();
-  std::printf("mesh h %.4g hc %.4g: %d triangles, %d nodes (%d vertices), %d unknowns (%d velocity, %d pressure)\n", h, hc,
-              solver.mesh().triangle_count(), n, nv, N, 2 * n, nv);
+  std::printf("mesh h %.4g hc %.4g: %d triangles, %d nodes (%d vertices), %d unknowns (%d velocity, %d pressure)\n", h,
+              hc, solver.mesh().triangle_count(), n, nv, N, 2 * n, nv);
 
   // 2. K time steps; keep the matrices of the last steps and the extrapolated guess.
   std::map<int, SpMat> old;  // lag -> matrix of step K - lag
@@ -437,10 +472,10 @@ int run(int argc, char** argv) {
   const SpMat A = solver.last_matrix();
   const Eigen::VectorXd b = solver.last_rhs();
   const Eigen::VectorXd guess = zero_guess ? Eigen::VectorXd::Zero(N) : Eigen::VectorXd(2 * u_km1 - u_km2);
-  std::printf("%d steps of dt %g (t = %g, inflow %s) in %.1f s; matrix: %ld nonzeros; guess: %s (residual %.2e)\n", steps,
-              dt, steps * dt, ramp > 0 ? ("ramped over " + std::to_string(ramp)).c_str() : "impulsive",
-              ms_since(t_steps) / 1e3, static_cast<long>(A.nonZeros()),
-              zero_guess ? "zero" : "2 u_{K-1} - u_{K-2}", residual(A, guess, b));
+  std::printf("%d steps of dt %g (t = %g, inflow %s) in %.1f s; matrix: %ld nonzeros; guess: %s (residual %.2e)\n",
+              steps, dt, steps * dt, ramp > 0 ? ("ramped over " + std::to_string(ramp)).c_str() : "impulsive",
+              ms_since(t_steps) / 1e3, static_cast<long>(A.nonZeros()), zero_guess ? "zero" : "2 u_{K-1} - u_{K-2}",
+              residual(A, guess, b));
 
   // Lumped P1 pressure mass (vertex positions; straight-sided approximation).
   Eigen::VectorXd lumped = Eigen::VectorXd::Zero(nv);
@@ -470,7 +505,8 @@ int run(int argc, char** argv) {
   std::map<int, double> lagged_setup_ms;
   PetscConfig lag_base;
   for (const auto& c : petsc_configs(rtol))
-    if (c.name == lag_config || (lag_config.empty() && !configs.empty() && c.name == configs.front().name)) lag_base = c;
+    if (c.name == lag_config || (lag_config.empty() && !configs.empty() && c.name == configs.front().name))
+      lag_base = c;
   if (!lag_config.empty() && lag_base.name.empty()) throw std::runtime_error("unknown --lag-config " + lag_config);
   if (!lag_base.name.empty())
     for (const auto& [lag, M] : Pold) {
@@ -547,15 +583,16 @@ int run(int argc, char** argv) {
   auto worst = [](const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); };
   const double umf_factor = median(umf_symbolic.solve) + median(umf_numeric.solve);
   const double umf_sol = median(umf_solve.solve);
-  std::printf("\nmedians of %d interleaved repetitions, ms (ratios to UMFPACK numeric factorisation + solve = %.1f ms)\n",
-              reps, median(umf_numeric.solve) + umf_sol);
+  std::printf(
+      "\nmedians of %d interleaved repetitions, ms (ratios to UMFPACK numeric factorisation + solve = %.1f ms)\n", reps,
+      median(umf_numeric.solve) + umf_sol);
   std::printf("%-22s %10s %10s %10s %6s %10s  %s\n", "solver", "setup", "solve", "total", "its", "residual", "ratio");
   const double ref = median(umf_numeric.solve) + umf_sol;
   std::printf("%-22s %10.1f %10.1f %10.1f %6s %10.2e  %.2f   (symbolic %.1f + numeric %.1f)\n", "umfpack_amd_sym",
               umf_factor, umf_sol, umf_factor + umf_sol, "-", worst(umf_res.residual), (umf_factor + umf_sol) / ref,
               median(umf_symbolic.solve), median(umf_numeric.solve));
-  std::printf("%-22s %10.1f %10.1f %10.1f %6s %10.2e  %.2f\n", "umfpack_numeric_only", median(umf_numeric.solve), umf_sol,
-              ref, "-", worst(umf_res.residual), 1.0);
+  std::printf("%-22s %10.1f %10.1f %10.1f %6s %10.2e  %.2f\n", "umfpack_numeric_only", median(umf_numeric.solve),
+              umf_sol, ref, "-", worst(umf_res.residual), 1.0);
   for (std::size_t c = 0; c < configs.size(); ++c) {
     const double su = median(ps[c].setup), so = median(ps[c].solve);
     std::printf("%-22s %10.1f %10.1f %10.1f %6.0f %10.2e  %.2f%s\n", configs[c].name.c_str(), su, so, su + so,

@@ -13,21 +13,21 @@
 //   bench_messaging                                    # 100 / 1,000 / 10,000 nodes
 //   bench_messaging --runs 3 --out messaging.csv       # medians of 3 runs, CSV
 //   bench_messaging --nodes 1000 --iterations 5000 --out m.json
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <poll.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstring>
 #include <fstream>
-#include <nlohmann/json.hpp>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "fsi/common/config.hpp"
@@ -82,9 +82,7 @@ class EchoFluid : public fsi::FluidModel {
     if (n_ < 1) s.fail("nodes", "must be >= 1");
   }
   fsi::InterfaceMeshData interface() const override { return line_interface(n_); }
-  fsi::FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override {
-    return {-d, v, 1, {}};
-  }
+  fsi::FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override { return {-d, v, 1, {}}; }
   fsi::FluidLoads solve_step(const fsi::StepInfo&, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override {
     return {-1e3 * d, v, 1, {}};  // traction = -force on the solid: the loop stays bounded
   }
@@ -97,8 +95,7 @@ class EchoFluid : public fsi::FluidModel {
 std::unique_ptr<fsi::protocol::Service> make_service(const std::string& kind) {
   if (kind == "solid")
     return std::make_unique<fsi::protocol::SolidService>(
-        [](const std::string& m) { return m == "echo" ? std::make_unique<EchoSolid>() : nullptr; },
-        "bench echo solid");
+        [](const std::string& m) { return m == "echo" ? std::make_unique<EchoSolid>() : nullptr; }, "bench echo solid");
   return std::make_unique<fsi::protocol::FluidService>(
       [](const std::string& m) { return m == "echo" ? std::make_unique<EchoFluid>() : nullptr; }, "bench echo fluid");
 }
@@ -167,9 +164,9 @@ class ChildServer {
       fsi::transport::Server server("tcp://127.0.0.1:*");
       report(server.endpoint());
       // Idle timeout: a parent that vanished without Stop does not leave us behind.
-      const bool clean = server.serve(
-          [&](const std::string& bytes, const std::string& peer, bool& stop) { return service->handle_bytes(bytes, stop, peer); },
-          std::chrono::seconds(60));
+      const bool clean = server.serve([&](const std::string& bytes, const std::string& peer,
+                                          bool& stop) { return service->handle_bytes(bytes, stop, peer); },
+                                      std::chrono::seconds(60));
       return clean ? 0 : 3;
     } catch (const std::exception& e) {
       report(std::string("ERROR ") + e.what());
@@ -182,8 +179,9 @@ class ChildServer {
     std::string line;
     while (line.find('\n') == std::string::npos) {
       const auto left = std::chrono::duration_cast<milliseconds>(end - Clock::now()).count();
-      if (left <= 0) throw std::runtime_error(fmt::format("{} server did not report its endpoint within {} ms", kind_,
-                                                          timeout.count()));
+      if (left <= 0)
+        throw std::runtime_error(
+            fmt::format("{} server did not report its endpoint within {} ms", kind_, timeout.count()));
       pollfd p{fd, POLLIN, 0};
       const int r = poll(&p, 1, static_cast<int>(left));
       if (r < 0 && errno == EINTR) continue;
@@ -331,13 +329,13 @@ double codec_us(int n, int iterations) {
 }
 
 // One measurement: configure both servers for n nodes, warm up, time `iterations`.
-Row measure(fsi::protocol::RemoteSolid& solid, fsi::protocol::RemoteFluid& fluid, int n, int warmup,
-            int iterations) {
+Row measure(fsi::protocol::RemoteSolid& solid, fsi::protocol::RemoteFluid& fluid, int n, int warmup, int iterations) {
   const auto scene = fsi::Scene::parse(scene_text(n), "<bench_messaging>");
   const double dt = 0.01;
   solid.configure(scene.section("solid"), fsi::SolidSetup{dt, 1.0, 0.0, {}});
   fluid.configure(scene.section("fluid"), fsi::FluidSetup{dt, 1.0, 0.0, -1.0, {}});
-  if (solid.interface().nodes() != static_cast<std::size_t>(n) || fluid.interface().nodes() != static_cast<std::size_t>(n))
+  if (solid.interface().nodes() != static_cast<std::size_t>(n) ||
+      fluid.interface().nodes() != static_cast<std::size_t>(n))
     throw std::runtime_error(fmt::format("servers report {} / {} interface nodes, expected {}",
                                          solid.interface().nodes(), fluid.interface().nodes(), n));
 
@@ -396,13 +394,15 @@ Row median_of(const std::vector<Row>& runs) {
 std::string kb(std::size_t bytes) { return fmt::format("{:.1f} KB", bytes / 1000.0); }
 
 void print_table(const std::vector<Row>& rows) {
-  fmt::print("\n| nodes | run | iterations | solid req / reply | fluid req / reply | solid round trip med / p99 us "
-             "| fluid round trip med / p99 us | coupling iteration med / p99 us | of which protocol (no sockets) us |\n");
+  fmt::print(
+      "\n| nodes | run | iterations | solid req / reply | fluid req / reply | solid round trip med / p99 us "
+      "| fluid round trip med / p99 us | coupling iteration med / p99 us | of which protocol (no sockets) us |\n");
   fmt::print("|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& r : rows)
     fmt::print("| {} | {} | {} | {} / {} | {} / {} | {:.0f} / {:.0f} | {:.0f} / {:.0f} | {:.0f} / {:.0f} | {:.0f} |\n",
                r.nodes, r.run, r.iterations, kb(r.solid_request), kb(r.solid_reply), kb(r.fluid_request),
-               kb(r.fluid_reply), r.solid_med, r.solid_p99, r.fluid_med, r.fluid_p99, r.iter_med, r.iter_p99, r.codec_med);
+               kb(r.fluid_reply), r.solid_med, r.solid_p99, r.fluid_med, r.fluid_p99, r.iter_med, r.iter_p99,
+               r.codec_med);
 }
 
 void write_out(const std::string& path, const std::vector<Row>& rows) {
@@ -415,8 +415,11 @@ void write_out(const std::string& path, const std::vector<Row>& rows) {
       j.push_back({{"nodes", r.nodes},
                    {"run", r.run},
                    {"iterations", r.iterations},
-                   {"bytes", {{"solid_request", r.solid_request}, {"solid_reply", r.solid_reply},
-                              {"fluid_request", r.fluid_request}, {"fluid_reply", r.fluid_reply}}},
+                   {"bytes",
+                    {{"solid_request", r.solid_request},
+                     {"solid_reply", r.solid_reply},
+                     {"fluid_request", r.fluid_request},
+                     {"fluid_reply", r.fluid_reply}}},
                    {"solid_round_trip_us", {{"median", r.solid_med}, {"p99", r.solid_p99}}},
                    {"fluid_round_trip_us", {{"median", r.fluid_med}, {"p99", r.fluid_p99}}},
                    {"coupling_iteration_us", {{"median", r.iter_med}, {"p99", r.iter_p99}}},
@@ -448,7 +451,8 @@ int main(int argc, char** argv) {
   app.add_option("--nodes", nodes, "interface node counts")->expected(1, -1);
   app.add_option("--iterations", iterations, "timed coupling iterations per node count (one value = all)")
       ->expected(1, -1);
-  app.add_option("--warmup", warmup, "untimed coupling iterations before each measurement")->check(CLI::NonNegativeNumber);
+  app.add_option("--warmup", warmup, "untimed coupling iterations before each measurement")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--runs", runs, "repeat each measurement; the last row per size is the median of the runs")
       ->check(CLI::PositiveNumber);
   app.add_option("--timeout", timeout_s, "seconds to wait for any reply or for a server to start")
@@ -514,10 +518,11 @@ int main(int argc, char** argv) {
 
   // 3. Report.
   print_table(rows);
-  fmt::print("\nbytes: protobuf payload per message (ZeroMQ adds a few bytes of framing); round trip = "
-             "RemoteSolid/RemoteFluid::solve_step as the coupler calls it (Eigen <-> protobuf, "
-             "serialise, send, server parse + echo + serialise, receive, parse, checks); protocol (no sockets) = the same "
-             "encode/decode and service work for one coupling iteration in-process, to separate it from the transport\n");
+  fmt::print(
+      "\nbytes: protobuf payload per message (ZeroMQ adds a few bytes of framing); round trip = "
+      "RemoteSolid/RemoteFluid::solve_step as the coupler calls it (Eigen <-> protobuf, "
+      "serialise, send, server parse + echo + serialise, receive, parse, checks); protocol (no sockets) = the same "
+      "encode/decode and service work for one coupling iteration in-process, to separate it from the transport\n");
   if (!out_path.empty()) {
     try {
       write_out(out_path, rows);

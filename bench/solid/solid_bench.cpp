@@ -6,20 +6,19 @@
 //   build/bin/solid_bench run configs/csm3.yaml solid.time_scheme=bdf1
 //   build/bin/solid_bench timing [cholmod|umfpack]                   # Newton iteration / step timings
 // Extra arguments key=value override scene keys (as the solid_server's --set).
-#include <Eigen/Core>
 #include <fmt/format.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-
-#include "fsi/common/version.hpp"
 #include <fstream>
 #include <iostream>
 #include <vector>
 
 #include "fsi/common/config.hpp"
+#include "fsi/common/version.hpp"
 #include "fsi/solid/fem_solid.hpp"
 
 namespace {
@@ -100,8 +99,10 @@ int run(const std::string& scene_file, const std::vector<std::string>& overrides
     for (std::size_t i = 0; i < ts.size(); ++i) out << fmt::format("{:.6f},{:.9e},{:.9e}\n", ts[i], ax[i], ay[i]);
   }
   const auto ox = analyse(ts, ax), oy = analyse(ts, ay);
-  fmt::print("A_x: mean {:.4f}e-3 amplitude {:.4f}e-3 frequency {:.4f} Hz\n", ox.mean * 1e3, ox.amplitude * 1e3, ox.frequency);
-  fmt::print("A_y: mean {:.4f}e-3 amplitude {:.4f}e-3 frequency {:.4f} Hz\n", oy.mean * 1e3, oy.amplitude * 1e3, oy.frequency);
+  fmt::print("A_x: mean {:.4f}e-3 amplitude {:.4f}e-3 frequency {:.4f} Hz\n", ox.mean * 1e3, ox.amplitude * 1e3,
+             ox.frequency);
+  fmt::print("A_y: mean {:.4f}e-3 amplitude {:.4f}e-3 frequency {:.4f} Hz\n", oy.mean * 1e3, oy.amplitude * 1e3,
+             oy.frequency);
   return 0;
 }
 
@@ -130,7 +131,8 @@ solid:
   clamp: bottom
   interface: [left, top, right]
   linear_solver: {}
-)", c.nx, c.ny, linear_solver);
+)",
+                                         c.nx, c.ny, linear_solver);
     auto scene = fsi::Scene::parse(text, "timing");
     fsi::SolidSetup setup{0.01, 1.0, 0.0, {}};
     fsi::solid::FemSolid solid;
@@ -149,7 +151,8 @@ solid:
       fsi::solid::SparseMatrix K;
       Eigen::VectorXd r;
       const auto a0 = Clock::now();
-      sys.assemble(solid.displacement(), Eigen::VectorXd::Zero(sys.num_dofs()), fsi::solid::TimeTerms{1e4, 1e2, {}, {}}, K, r);
+      sys.assemble(solid.displacement(), Eigen::VectorXd::Zero(sys.num_dofs()), fsi::solid::TimeTerms{1e4, 1e2, {}, {}},
+                   K, r);
       const auto a1 = Clock::now();
       sys.linear_solver().factorize(K);
       const Eigen::VectorXd x = sys.linear_solver().solve(r);
@@ -158,10 +161,11 @@ solid:
       factor_ms.push_back(std::chrono::duration<double, std::milli>(a2 - a1).count());
       iter_ms.push_back(std::chrono::duration<double, std::milli>(a2 - a0).count());
     }
-    fmt::print("[{}] mesh {} ({} free dofs): Newton iteration {:.3f} ms (assembly {:.3f} + factorise/solve {:.3f}), "
-               "step {:.3f} ms ({:.1f} iterations/step), medians of 40\n",
-               linear_solver, c.name, solid.system().num_free(), median(iter_ms), median(assemble_ms), median(factor_ms),
-               median(step_ms), iterations / 40.0);
+    fmt::print(
+        "[{}] mesh {} ({} free dofs): Newton iteration {:.3f} ms (assembly {:.3f} + factorise/solve {:.3f}), "
+        "step {:.3f} ms ({:.1f} iterations/step), medians of 40\n",
+        linear_solver, c.name, solid.system().num_free(), median(iter_ms), median(assemble_ms), median(factor_ms),
+        median(step_ms), iterations / 40.0);
   }
   return 0;
 }

@@ -1,14 +1,14 @@
 #include "fsi/common/config.hpp"
 
-#include "fsi/common/utf8.hpp"
-#include "fsi/common/scene_schema.hpp"
-
 #include <fmt/format.h>
 
 #include <cmath>
-#include <map>
 #include <fstream>
+#include <map>
 #include <sstream>
+
+#include "fsi/common/scene_schema.hpp"
+#include "fsi/common/utf8.hpp"
 
 namespace fsi {
 
@@ -34,8 +34,7 @@ std::string mark_string(const std::string& origin, const YAML::Mark& mark) {
 
 void apply_override(YAML::Node root, const std::string& assignment, const std::string& origin) {
   const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw ConfigError("--set '" + assignment + "': expected dotted.key=value");
+  if (eq == std::string::npos || eq == 0) throw ConfigError("--set '" + assignment + "': expected dotted.key=value");
   const auto parts = split_dotted(assignment.substr(0, eq));
   YAML::Node value;
   try {
@@ -48,8 +47,7 @@ void apply_override(YAML::Node root, const std::string& assignment, const std::s
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
     YAML::Node next = chain.back()[parts[i]];
     if (next && !next.IsMap())
-      throw ConfigError("--set '" + assignment + "': '" + parts[i] + "' in " + origin +
-                        " is not a section");
+      throw ConfigError("--set '" + assignment + "': '" + parts[i] + "' in " + origin + " is not a section");
     chain.push_back(next);
   }
   chain.back()[parts.back()] = value;
@@ -63,8 +61,8 @@ constexpr std::size_t kMaxSceneNodes = 100000;
 constexpr int kMaxSceneDepth = 64;
 
 // yaml-cpp keeps the last of two equal keys silently: refuse them, naming both lines.
-void check_duplicates(const YAML::Node& node, const std::string& path, const std::string& origin,
-                      std::size_t& visited, int depth = 0) {
+void check_duplicates(const YAML::Node& node, const std::string& path, const std::string& origin, std::size_t& visited,
+                      int depth = 0) {
   if (depth > kMaxSceneDepth)
     throw ConfigError(origin + ": '" + path + "' is nested more than " + std::to_string(kMaxSceneDepth) +
                       " levels deep; is an anchor (&) used inside itself?");
@@ -88,9 +86,8 @@ void check_duplicates(const YAML::Node& node, const std::string& path, const std
   }
 }
 
-void collect_unused(const YAML::Node& node, const std::string& path,
-                    const std::set<std::string>& used, const std::string& origin,
-                    std::vector<std::string>& unknown) {
+void collect_unused(const YAML::Node& node, const std::string& path, const std::set<std::string>& used,
+                    const std::string& origin, std::vector<std::string>& unknown) {
   if (!node.IsMap()) return;
   for (const auto& kv : node) {
     const std::string key = kv.first.Scalar();
@@ -122,8 +119,10 @@ namespace {
 std::string place_of(const std::string& text, const std::string& origin, std::size_t offset) {
   std::size_t line = 1, column = 1;
   for (std::size_t i = 0; i < offset && i < text.size(); ++i) {
-    if (text[i] == '\n') ++line, column = 1;
-    else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) ++column;  // count characters
+    if (text[i] == '\n')
+      ++line, column = 1;
+    else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80)
+      ++column;  // count characters
   }
   return fmt::format("{}:{}:{}", origin, line, column);
 }
@@ -138,16 +137,16 @@ void refuse_unreadable_bytes(const std::string& text, const std::string& origin,
     throw ConfigError((override_text.empty() ? place_of(text, origin, nul) : origin + where_prefix) +
                       ": a NUL byte (0x00) in the scene; a scene is UTF-8 text");
   if (const auto bad = first_invalid_utf8(text); bad != std::string::npos)
-    throw ConfigError(fmt::format("{}: byte 0x{:02X} is not UTF-8 (a Latin-1 or other 8-bit character?); save the "
-                                  "scene as UTF-8",
-                                  override_text.empty() ? place_of(text, origin, bad) : origin + where_prefix,
-                                  static_cast<unsigned char>(text[bad])));
+    throw ConfigError(
+        fmt::format("{}: byte 0x{:02X} is not UTF-8 (a Latin-1 or other 8-bit character?); save the "
+                    "scene as UTF-8",
+                    override_text.empty() ? place_of(text, origin, bad) : origin + where_prefix,
+                    static_cast<unsigned char>(text[bad])));
 }
 
 }  // namespace
 
-Scene Scene::parse(const std::string& text, const std::string& origin,
-                   const std::vector<std::string>& overrides) {
+Scene Scene::parse(const std::string& text, const std::string& origin, const std::vector<std::string>& overrides) {
   Scene scene;
   scene.state_ = std::make_shared<State>();
   scene.state_->origin = origin;
@@ -221,9 +220,7 @@ void Scene::check_all_used(const std::string& prefix) const {
 ConfigSection::ConfigSection(std::shared_ptr<Scene::State> state, YAML::Node node, std::string path)
     : state_(std::move(state)), node_(node), path_(std::move(path)) {}
 
-std::string ConfigSection::full_key(const std::string& key) const {
-  return path_.empty() ? key : path_ + "." + key;
-}
+std::string ConfigSection::full_key(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
 YAML::Node ConfigSection::lookup(const std::string& key) const {
   state_->used.insert(full_key(key));

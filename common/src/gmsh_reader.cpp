@@ -23,24 +23,42 @@ namespace {
 // Nodes per element for the gmsh types we accept (0 = unsupported).
 int nodes_per_element(int type) {
   switch (type) {
-    case 1: return 2;    // line2
-    case 2: return 3;    // tri3
-    case 3: return 4;    // quad4
-    case 8: return 3;    // line3
-    case 9: return 6;    // tri6
-    case 10: return 9;   // quad9
-    case 15: return 1;   // point
-    case 16: return 8;   // quad8
-    default: return 0;
+    case 1:
+      return 2;  // line2
+    case 2:
+      return 3;  // tri3
+    case 3:
+      return 4;  // quad4
+    case 8:
+      return 3;  // line3
+    case 9:
+      return 6;  // tri6
+    case 10:
+      return 9;  // quad9
+    case 15:
+      return 1;  // point
+    case 16:
+      return 8;  // quad8
+    default:
+      return 0;
   }
 }
 
 int dimension_of(int type) {
   switch (type) {
-    case 15: return 0;
-    case 1: case 8: return 1;
-    case 2: case 3: case 9: case 10: case 16: return 2;
-    default: return 3;
+    case 15:
+      return 0;
+    case 1:
+    case 8:
+      return 1;
+    case 2:
+    case 3:
+    case 9:
+    case 10:
+    case 16:
+      return 2;
+    default:
+      return 3;
   }
 }
 
@@ -108,22 +126,22 @@ struct RawElement {
 };
 
 struct ReaderState {
-  std::map<std::pair<int, int>, std::string> names;             // (dim, tag) -> name
-  std::vector<std::pair<long, Eigen::Vector2d>> nodes;           // gmsh tag, position
-  std::map<std::pair<int, int>, std::vector<RawElement>> groups;  // (dim, physical) -> elements
-  std::map<std::pair<int, int>, int> group_type;                  // first element type
+  std::map<std::pair<int, int>, std::string> names;                  // (dim, tag) -> name
+  std::vector<std::pair<long, Eigen::Vector2d>> nodes;               // gmsh tag, position
+  std::map<std::pair<int, int>, std::vector<RawElement>> groups;     // (dim, physical) -> elements
+  std::map<std::pair<int, int>, int> group_type;                     // first element type
   std::map<std::pair<int, int>, std::vector<int>> entity_physicals;  // 4.1: (dim, entity) -> physicals
 };
 
-void add_element(LineReader& reader, ReaderState& state, int dim, int physical, int type,
-                 std::vector<long> nodes) {
+void add_element(LineReader& reader, ReaderState& state, int dim, int physical, int type, std::vector<long> nodes) {
   if (dim < 1 || dim > 2 || physical == 0) return;
   auto key = std::make_pair(dim, physical);
   auto [it, inserted] = state.group_type.emplace(key, type);
   if (!inserted && it->second != type)
-    reader.fail(fmt::format("physical group {} (dim {}) mixes element types {} and {}; "
-                            "one type per group is supported",
-                            physical, dim, it->second, type));
+    reader.fail(
+        fmt::format("physical group {} (dim {}) mixes element types {} and {}; "
+                    "one type per group is supported",
+                    physical, dim, it->second, type));
   state.groups[key].push_back({type, std::move(nodes)});
 }
 
@@ -167,8 +185,7 @@ void read_elements_v2(LineReader& reader, ReaderState& state) {
     if (static_cast<int>(v.size()) != 3 + ntags + nn)
       reader.fail(fmt::format("element {} of type {} should have {} tags and {} nodes", v[0], type, ntags, nn));
     const int physical = ntags > 0 ? static_cast<int>(v[3]) : 0;
-    add_element(reader, state, dimension_of(type), physical, type,
-                std::vector<long>(v.begin() + 3 + ntags, v.end()));
+    add_element(reader, state, dimension_of(type), physical, type, std::vector<long>(v.begin() + 3 + ntags, v.end()));
   }
   if (reader.require("$EndElements") != "$EndElements") reader.fail("expected $EndElements");
 }
@@ -193,7 +210,8 @@ void read_entities_v4(LineReader& reader, ReaderState& state) {
 
 void read_nodes_v4(LineReader& reader, ReaderState& state) {
   const auto header = parse_numbers<long>(reader, reader.require("node block header"), 4, "'blocks nodes min max'");
-  state.nodes.reserve(static_cast<std::size_t>(std::min(checked_count(reader, header[1], "the node count"), kReserveAtMost)));
+  state.nodes.reserve(
+      static_cast<std::size_t>(std::min(checked_count(reader, header[1], "the node count"), kReserveAtMost)));
   for (long b = 0; b < header[0]; ++b) {
     const auto bh = parse_numbers<long>(reader, reader.require("an entity block"), 4, "'dim tag parametric n'");
     const long n = checked_count(reader, bh[3], "the block's node count");
@@ -211,7 +229,8 @@ void read_nodes_v4(LineReader& reader, ReaderState& state) {
 }
 
 void read_elements_v4(LineReader& reader, ReaderState& state) {
-  const auto header = parse_numbers<long>(reader, reader.require("element block header"), 4, "'blocks elements min max'");
+  const auto header =
+      parse_numbers<long>(reader, reader.require("element block header"), 4, "'blocks elements min max'");
   for (long b = 0; b < header[0]; ++b) {
     const auto bh = parse_numbers<long>(reader, reader.require("an element block"), 4, "'dim tag type n'");
     const int dim = static_cast<int>(bh[0]);
@@ -326,7 +345,8 @@ GmshMesh read_gmsh(std::istream& in, const std::filesystem::path& path) {
         const auto it = index.find(elements[e].nodes[static_cast<std::size_t>(k)]);
         if (it == index.end())
           throw std::runtime_error(fmt::format("{}: element of group '{}' uses node {} that is not in $Nodes",
-                                               path.string(), group.name, elements[e].nodes[static_cast<std::size_t>(k)]));
+                                               path.string(), group.name,
+                                               elements[e].nodes[static_cast<std::size_t>(k)]));
         group.elements(static_cast<Eigen::Index>(e), k) = it->second;
       }
     mesh.groups.push_back(std::move(group));

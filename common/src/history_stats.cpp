@@ -44,9 +44,12 @@ double half_range(const std::vector<double>& t, const std::vector<double>& y, do
 
 const char* to_string(HistoryStats::Kind kind) {
   switch (kind) {
-    case HistoryStats::Kind::Steady: return "steady";
-    case HistoryStats::Kind::Periodic: return "periodic";
-    case HistoryStats::Kind::Changing: return "changing";
+    case HistoryStats::Kind::Steady:
+      return "steady";
+    case HistoryStats::Kind::Periodic:
+      return "periodic";
+    case HistoryStats::Kind::Changing:
+      return "changing";
   }
   return "changing";
 }
@@ -66,8 +69,7 @@ std::vector<double> upward_crossings(const std::vector<double>& t, const std::ve
   return up;
 }
 
-HistoryStats history_stats(const std::vector<double>& t, const std::vector<double>& y,
-                           const HistoryStatsOptions& o) {
+HistoryStats history_stats(const std::vector<double>& t, const std::vector<double>& y, const HistoryStatsOptions& o) {
   if (t.empty() || t.size() != y.size())
     throw std::invalid_argument(fmt::format("history_stats: {} times and {} values", t.size(), y.size()));
   HistoryStats s;
@@ -139,18 +141,20 @@ std::string describe(const HistoryStats& s) {
     case HistoryStats::Kind::Steady:
       return fmt::format("steady (change over the last 10 %: {:.2g})", s.change);
     case HistoryStats::Kind::Periodic: {
-      std::string d = fmt::format("mean {:.6g}, amplitude {:.4g}, frequency {:.4g} Hz over the last {} periods "
-                                  "[{:.4g}, {:.4g}] s",
-                                  s.mean, s.amplitude, s.frequency, s.periods, s.t0, s.t1);
+      std::string d = fmt::format(
+          "mean {:.6g}, amplitude {:.4g}, frequency {:.4g} Hz over the last {} periods "
+          "[{:.4g}, {:.4g}] s",
+          s.mean, s.amplitude, s.frequency, s.periods, s.t0, s.t1);
       if (std::abs(s.amplitude_change) > 0.02)
         d += fmt::format("; amplitude {} {:.0f} % from the first to the last (not settled)",
                          s.amplitude_change > 0 ? "grew" : "fell", 100 * std::abs(s.amplitude_change));
       return d;
     }
     case HistoryStats::Kind::Changing:
-      return s.periods > 0 ? fmt::format("still changing: {} whole period{} in the second half, fewer than 3 "
-                                         "(run longer for a mean, amplitude and frequency)",
-                                         s.periods, s.periods == 1 ? "" : "s")
+      return s.periods > 0 ? fmt::format(
+                                 "still changing: {} whole period{} in the second half, fewer than 3 "
+                                 "(run longer for a mean, amplitude and frequency)",
+                                 s.periods, s.periods == 1 ? "" : "s")
                            : fmt::format("still changing (by {:.2g} over the last 10 %)", s.change);
   }
   return "";

@@ -1,13 +1,13 @@
 #include "fsi/common/log.hpp"
-#include "fsi/common/log_file.hpp"
 
 #include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 
 #include <algorithm>
-
 #include <cstdlib>
 #include <mutex>
+
+#include "fsi/common/log_file.hpp"
 
 namespace fsi {
 namespace {

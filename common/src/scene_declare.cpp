@@ -41,9 +41,7 @@ Key choice(std::string n, std::vector<std::string> values, std::string m) {
   return k;
 }
 Key vector2(std::string n, std::string m) { return make(std::move(n), Type::Vector2, std::move(m)); }
-Key number_or_vector2(std::string n, std::string m) {
-  return make(std::move(n), Type::NumberOrVector2, std::move(m));
-}
+Key number_or_vector2(std::string n, std::string m) { return make(std::move(n), Type::NumberOrVector2, std::move(m)); }
 Key names(std::string n, std::string m) { return make(std::move(n), Type::Names, std::move(m)); }
 Key string_list(std::string n, std::string m) { return make(std::move(n), Type::StringList, std::move(m)); }
 Key int_list(std::string n, int size, std::string m) {
@@ -69,9 +67,12 @@ Key selector_section(std::string n, std::string m, std::string selector, std::ve
 void declare(const Key& section) {
   auto& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
-  const auto same = std::find_if(r.sections.begin(), r.sections.end(), [&](const Key& k) { return k.name == section.name; });
-  if (same != r.sections.end()) *same = section;
-  else r.sections.push_back(section);
+  const auto same =
+      std::find_if(r.sections.begin(), r.sections.end(), [&](const Key& k) { return k.name == section.name; });
+  if (same != r.sections.end())
+    *same = section;
+  else
+    r.sections.push_back(section);
 }
 
 std::vector<Key> scene_keys() {

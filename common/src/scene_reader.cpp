@@ -33,8 +33,7 @@ std::string one_of(const std::vector<std::string>& values) {
 namespace {
 
 const std::vector<Key>& children_of(const Key& k) {
-  if (k.type != Type::Section && k.type != Type::SectionList)
-    detail::misuse(k.name, "is not a section");
+  if (k.type != Type::Section && k.type != Type::SectionList) detail::misuse(k.name, "is not a section");
   return k.children;
 }
 

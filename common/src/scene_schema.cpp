@@ -80,40 +80,68 @@ namespace {
 
 const char* type_text(Type t) {
   switch (t) {
-    case Type::Number: return "a number";
-    case Type::Integer: return "an integer";
-    case Type::Bool: return "a boolean (true/false)";
-    case Type::String: return "a string";
-    case Type::Enum: return "one of";
-    case Type::Vector2: return "a list of 2 numbers [x, y]";
-    case Type::NumberOrVector2: return "a number or a list [x, y]";
-    case Type::Names: return "a name or a list of names";
-    case Type::StringList: return "a list of names";
-    case Type::IntList: return "a list of integers";
-    case Type::PointPair: return "[[x0, y0], [x1, y1]]";
-    case Type::Section: return "a section (a map of keys)";
-    case Type::SectionList: return "a list of sections";
-    case Type::NamedMap: return "a map of names";
+    case Type::Number:
+      return "a number";
+    case Type::Integer:
+      return "an integer";
+    case Type::Bool:
+      return "a boolean (true/false)";
+    case Type::String:
+      return "a string";
+    case Type::Enum:
+      return "one of";
+    case Type::Vector2:
+      return "a list of 2 numbers [x, y]";
+    case Type::NumberOrVector2:
+      return "a number or a list [x, y]";
+    case Type::Names:
+      return "a name or a list of names";
+    case Type::StringList:
+      return "a list of names";
+    case Type::IntList:
+      return "a list of integers";
+    case Type::PointPair:
+      return "[[x0, y0], [x1, y1]]";
+    case Type::Section:
+      return "a section (a map of keys)";
+    case Type::SectionList:
+      return "a list of sections";
+    case Type::NamedMap:
+      return "a map of names";
   }
   return "";
 }
 
 const char* short_type(Type t) {
   switch (t) {
-    case Type::Number: return "number";
-    case Type::Integer: return "integer";
-    case Type::Bool: return "bool";
-    case Type::String: return "string";
-    case Type::Enum: return "enum";
-    case Type::Vector2: return "[x, y]";
-    case Type::NumberOrVector2: return "number or [x, y]";
-    case Type::Names: return "name or list of names";
-    case Type::StringList: return "list of names";
-    case Type::IntList: return "list of integers";
-    case Type::PointPair: return "[[x0, y0], [x1, y1]]";
-    case Type::Section: return "section";
-    case Type::SectionList: return "list of sections";
-    case Type::NamedMap: return "map";
+    case Type::Number:
+      return "number";
+    case Type::Integer:
+      return "integer";
+    case Type::Bool:
+      return "bool";
+    case Type::String:
+      return "string";
+    case Type::Enum:
+      return "enum";
+    case Type::Vector2:
+      return "[x, y]";
+    case Type::NumberOrVector2:
+      return "number or [x, y]";
+    case Type::Names:
+      return "name or list of names";
+    case Type::StringList:
+      return "list of names";
+    case Type::IntList:
+      return "list of integers";
+    case Type::PointPair:
+      return "[[x0, y0], [x1, y1]]";
+    case Type::Section:
+      return "section";
+    case Type::SectionList:
+      return "list of sections";
+    case Type::NamedMap:
+      return "map";
   }
   return "";
 }
@@ -198,8 +226,8 @@ class Checker {
     if (coupled && (!solid || !fluid))
       add("", "", fmt::format("{}: a coupled scene (with 'coupling') needs 'solid' and 'fluid'", scene_.origin()));
     if (!coupled && solid == fluid)
-      add("", "", fmt::format("{}: a scene without 'coupling' must have exactly one of 'solid' or 'fluid'",
-                              scene_.origin()));
+      add("", "",
+          fmt::format("{}: a scene without 'coupling' must have exactly one of 'solid' or 'fluid'", scene_.origin()));
     return std::move(result_);
   }
 
@@ -277,8 +305,8 @@ class Checker {
   }
 
   // Checks the keys of `map` against `keys`; `path` is the map's dotted key, `mark` its key's place.
-  void check_map(const YAML::Node& map, const std::vector<Key>& keys, const std::string& path,
-                 const YAML::Mark& mark, bool top = false) {
+  void check_map(const YAML::Node& map, const std::vector<Key>& keys, const std::string& path, const YAML::Mark& mark,
+                 bool top = false) {
     std::vector<std::string> valid;  // names usable here
     for (const auto& k : keys)
       if (applies(k, map)) valid.push_back(k.name);
@@ -339,8 +367,8 @@ class Checker {
             add(section_at, path, fmt::format("'{}' needs one of {}", path, which));
           else
             add(where(full(path, given[1]), mark_of(map, given[1])), full(path, given[1]),
-                fmt::format("give exactly one of {} in '{}' (both '{}' and '{}' are given)", which, path,
-                            given[0], given[1]));
+                fmt::format("give exactly one of {} in '{}' (both '{}' and '{}' are given)", which, path, given[0],
+                            given[1]));
         }
       }
     }
@@ -357,8 +385,8 @@ class Checker {
     if (k.type == Type::Enum) expected += " " + join(k.allowed);
     if (k.type == Type::IntList && k.size) expected = fmt::format("a list of {} integers", k.size);
     if (k.type == Type::StringList && k.size) expected = fmt::format("a list of {} names", k.size);
-    add(at, key, fmt::format("'{}' must be {}, got {}", key, expected,
-                             v.IsScalar() ? "'" + v.Scalar() + "'" : scalar_text(v)));
+    add(at, key,
+        fmt::format("'{}' must be {}, got {}", key, expected, v.IsScalar() ? "'" + v.Scalar() + "'" : scalar_text(v)));
   }
 
   void check_range(const Key& k, double value, const YAML::Node& v, const std::string& key, const std::string& at) {
@@ -391,7 +419,8 @@ class Checker {
         if (!v.IsScalar()) return type_error(k, v, key, at);
         if (std::find(k.allowed.begin(), k.allowed.end(), v.Scalar()) != k.allowed.end()) return;
         std::string message = fmt::format("'{}' must be one of {}, got '{}'", key, join(k.allowed), v.Scalar());
-        if (const auto s = closest(v.Scalar(), k.allowed); !s.empty()) message += fmt::format(" (did you mean '{}'?)", s);
+        if (const auto s = closest(v.Scalar(), k.allowed); !s.empty())
+          message += fmt::format(" (did you mean '{}'?)", s);
         return add(at, key, message);
       }
       case Type::Vector2:
@@ -461,14 +490,16 @@ class Checker {
       add(at, selector_key, fmt::format("'{}' is required but missing (one of {})", selector_key, join(values)));
       return;
     }
-    const auto variant = std::find_if(k.variants.begin(), k.variants.end(),
-                                      [&](const Key::Variant& x) { return selector.IsScalar() && x.value == selector.Scalar(); });
+    const auto variant = std::find_if(k.variants.begin(), k.variants.end(), [&](const Key::Variant& x) {
+      return selector.IsScalar() && x.value == selector.Scalar();
+    });
     if (variant == k.variants.end()) {
       const std::string selector_at = where(selector_key, mark_of(v, k.selector));
       std::string message =
           fmt::format("'{}' must be one of {}, got {}", selector_key, join(values), scalar_text(selector));
       if (selector.IsScalar())
-        if (const auto s = closest(selector.Scalar(), values); !s.empty()) message += fmt::format(" (did you mean '{}'?)", s);
+        if (const auto s = closest(selector.Scalar(), values); !s.empty())
+          message += fmt::format(" (did you mean '{}'?)", s);
       add(selector_at, selector_key, message);
       return;
     }
@@ -579,8 +610,10 @@ namespace {
 std::string escape(std::string s) {
   std::string out;
   for (char c : s) {
-    if (c == '|') out += "\\|";
-    else out += c;
+    if (c == '|')
+      out += "\\|";
+    else
+      out += c;
   }
   return out;
 }
@@ -673,7 +706,8 @@ std::string reference_markdown() {
       keys_with_nested(out, k.children, k.name);
       continue;
     }
-    out << "\n## " << k.name << "\n\n" << k.meaning << ". `" << k.name << "." << k.selector
+    out << "\n## " << k.name << "\n\n"
+        << k.meaning << ". `" << k.name << "." << k.selector
         << "` (required) selects the model; each model takes the keys of its table.\n";
     for (const auto& v : k.variants) {
       out << "\n### " << k.name << "." << k.selector << ": " << v.value << "\n\n" << v.meaning << ".\n\n";

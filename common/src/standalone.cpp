@@ -28,14 +28,13 @@ struct Interrupted {
 
 template <class Model, class SetupFn, class StepFn>
 int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::filesystem::path& out_dir,
-             const char* runner, const char* section, SetupFn&& setup_fn, StepFn&& step_fn,
-             double& compute_time) {
+             const char* runner, const char* section, SetupFn&& setup_fn, StepFn&& step_fn, double& compute_time) {
   add_log_file(out_dir / (std::string(runner) + ".log"));  // OUT/solid_server.log, OUT/fluid_server.log
   auto log = logger(runner);
   RunReport report(out_dir, scene, runner);
   const double start = now_seconds();
   int steps_done = 0;
-  long iterations = 0;  // the solver's nonlinear iterations (Newton / fluid solves), all steps
+  long iterations = 0;                 // the solver's nonlinear iterations (Newton / fluid solves), all steps
   std::map<std::string, double> last;  // the last step's probes, named as in probes.csv
   std::signal(SIGINT, on_standalone_signal);
   std::signal(SIGTERM, on_standalone_signal);
@@ -43,19 +42,20 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     scene.name();
     const TimeSettings time = read_time(scene);
     if (time.checkpoint_every > 0)
-      log->warn("time.checkpoint_every: checkpoints are written by coupled runs only; this {} run writes none", section);
+      log->warn("time.checkpoint_every: checkpoints are written by coupled runs only; this {} run writes none",
+                section);
     setup_fn(time);
     report.data()["setup_seconds"] = now_seconds() - start;
     for (const auto& [k, v] : model->sizes())  // counts: integers in the JSON
-      report.data()[k] = v == std::floor(v) && std::abs(v) < 9e15 ? nlohmann::json(static_cast<std::int64_t>(v))
-                                                                   : nlohmann::json(v);
+      report.data()[k] =
+          v == std::floor(v) && std::abs(v) < 9e15 ? nlohmann::json(static_cast<std::int64_t>(v)) : nlohmann::json(v);
     if (time.output_every > 0) model->write_output(StepInfo{0.0, time.dt, 0, 0});  // the initial state
     ProbeTable probes(out_dir / "probes.csv");
     Progress progress(runner, time.steps);
     for (int n = 1; n <= time.steps; ++n) {
       if (g_standalone_signal)
-        throw Interrupted{fmt::format("interrupted by {} before step {}",
-                                      g_standalone_signal == SIGINT ? "SIGINT" : "SIGTERM", n)};
+        throw Interrupted{
+            fmt::format("interrupted by {} before step {}", g_standalone_signal == SIGINT ? "SIGINT" : "SIGTERM", n)};
       StepInfo info{n * time.dt, time.dt, n, 0};
       const double t0 = now_seconds();
       auto [values, step_iterations] = step_fn(info);
@@ -81,7 +81,7 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     }
     report.set_status("completed");
     report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
-        if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
+    if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
   } catch (const Interrupted& e) {
     report.set_status("interrupted", e.reason);
   } catch (const ConfigError& e) {
@@ -95,7 +95,7 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
   report.data()["solver_iterations"] = iterations;
   if (!last.empty()) report.data()["final"] = last;  // the last row of probes.csv
   report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
-        if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
+  if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
   report.write();
   const std::string status = report.data()["status"];
   if (status != "completed") {
@@ -112,27 +112,29 @@ const schema::Key& time_section() {
   using namespace schema;
   static const Key time = [] {
     Key k =
-      section("time", "time stepping (every runner)",
-              {
-                  number("dt", "time step").req().gt(0).in_unit("s"),
-                  number("end", "final time; a whole number of time steps").req().gt(0).in_unit("s"),
-                  integer("output_every", "VTK of both solvers (and the coupling interfaces) every N steps and at "
-                                          "t = 0; 0 = none")
-                      .def("0")
-                      .ge(0)
-                      .in_unit("steps"),
-                  choice("vtk_format", {"binary", "ascii"},
-                         "VTK encoding: binary = ParaView's default (arrays zlib-compressed in one appended block, "
-                         "doubles exact), ascii = text with 10 significant digits")
-                      .def("binary"),
-                  integer("checkpoint_every", "coupled runs: a checkpoint of both solvers and the coupler every N "
-                                              "accepted steps; 0 = none")
-                      .def("0")
-                      .ge(0)
-                      .in_unit("steps"),
-                  integer("checkpoint_keep", "the newest K complete checkpoints are kept").def("2").ge(1),
-              })
-          .req();
+        section("time", "time stepping (every runner)",
+                {
+                    number("dt", "time step").req().gt(0).in_unit("s"),
+                    number("end", "final time; a whole number of time steps").req().gt(0).in_unit("s"),
+                    integer("output_every",
+                            "VTK of both solvers (and the coupling interfaces) every N steps and at "
+                            "t = 0; 0 = none")
+                        .def("0")
+                        .ge(0)
+                        .in_unit("steps"),
+                    choice("vtk_format", {"binary", "ascii"},
+                           "VTK encoding: binary = ParaView's default (arrays zlib-compressed in one appended block, "
+                           "doubles exact), ascii = text with 10 significant digits")
+                        .def("binary"),
+                    integer("checkpoint_every",
+                            "coupled runs: a checkpoint of both solvers and the coupler every N "
+                            "accepted steps; 0 = none")
+                        .def("0")
+                        .ge(0)
+                        .in_unit("steps"),
+                    integer("checkpoint_keep", "the newest K complete checkpoints are kept").def("2").ge(1),
+                })
+            .req();
     k.check = [](const Scene& scene) { (void)read_time(scene); };  // end: a whole number of steps
     return k;
   }();
@@ -189,8 +191,9 @@ void Progress::update(int step, double time, const std::string& extra) {
     per_step = (now - first_done_) / (step - first_done_step_);
   else if (step > first_)
     per_step = elapsed / (step - first_);
-  logger(logger_name_)->info("step {}/{} t={:.5g} {} elapsed {:.1f} s, ETA {:.1f} s", step, total_, time, extra,
-                             elapsed, per_step * (total_ - step));
+  logger(logger_name_)
+      ->info("step {}/{} t={:.5g} {} elapsed {:.1f} s, ETA {:.1f} s", step, total_, time, extra, elapsed,
+             per_step * (total_ - step));
 }
 
 void Progress::within(int step, const std::string& extra) {
@@ -208,9 +211,9 @@ int run_standalone_solid(const SolidFactory& factory, const Scene& scene, const 
       [&](const TimeSettings& time) {
         const auto section = scene.section("solid");
         model = make_model(factory, section, "solid");
-        model->configure(section, SolidSetup{time.dt, time.end, 0.0,
-                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(),
-                                             time.vtk_format});
+        model->configure(
+            section, SolidSetup{time.dt, time.end, 0.0,
+                                time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(), time.vtk_format});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {
@@ -229,9 +232,9 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
       [&](const TimeSettings& time) {
         const auto section = scene.section("fluid");
         model = make_model(factory, section, "fluid");
-        model->configure(section, FluidSetup{time.dt, time.end, 0.0, -1.0,
-                                             time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(),
-                                             time.vtk_format});
+        model->configure(
+            section, FluidSetup{time.dt, time.end, 0.0, -1.0,
+                                time.output_every > 0 ? out_dir / "vtk" : std::filesystem::path(), time.vtk_format});
         scene.check_all_used();
       },
       [&](const StepInfo& info) {

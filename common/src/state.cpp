@@ -45,11 +45,16 @@ class Reader {
 
 const char* type_name(std::uint8_t t) {
   switch (t) {
-    case 1: return "vector";
-    case 2: return "real";
-    case 3: return "integer";
-    case 4: return "text";
-    default: return "unknown";
+    case 1:
+      return "vector";
+    case 2:
+      return "real";
+    case 3:
+      return "integer";
+    case 4:
+      return "text";
+    default:
+      return "unknown";
   }
 }
 
@@ -62,7 +67,8 @@ void StateArchive::put(const std::string& name, const Eigen::VectorXd& values) {
 }
 
 void StateArchive::put(const std::string& name, const std::vector<double>& values) {
-  put(name, Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()))));
+  put(name,
+      Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()))));
 }
 
 void StateArchive::put(const std::string& name, double value) {
@@ -98,9 +104,10 @@ Eigen::VectorXd StateArchive::vector(const std::string& name, Eigen::Index expec
   const Entry& e = entry(name, Type::Vector);
   const auto n = static_cast<Eigen::Index>(e.bytes.size() / sizeof(double));
   if (expected_size >= 0 && n != expected_size)
-    throw StateError(fmt::format("{}: entry '{}' has {} values, this configuration needs {} (a different mesh or "
-                                 "scene?)",
-                                 where_, name, n, expected_size));
+    throw StateError(
+        fmt::format("{}: entry '{}' has {} values, this configuration needs {} (a different mesh or "
+                    "scene?)",
+                    where_, name, n, expected_size));
   Eigen::VectorXd v(n);
   if (n > 0) std::memcpy(v.data(), e.bytes.data(), e.bytes.size());
   return v;
@@ -125,7 +132,8 @@ Eigen::MatrixXd StateArchive::matrix(const std::string& name) const {
   const auto rows = static_cast<Eigen::Index>(integer(name + ".rows"));
   if (rows < 0 || (rows == 0 && v.size() != 0) || (rows > 0 && v.size() % rows != 0))
     throw StateError(fmt::format("{}: matrix '{}' has {} values for {} rows", where_, name, v.size(), rows));
-  return rows == 0 ? Eigen::MatrixXd() : Eigen::MatrixXd(Eigen::Map<const Eigen::MatrixXd>(v.data(), rows, v.size() / rows));
+  return rows == 0 ? Eigen::MatrixXd()
+                   : Eigen::MatrixXd(Eigen::Map<const Eigen::MatrixXd>(v.data(), rows, v.size() / rows));
 }
 
 std::vector<std::string> StateArchive::names() const {
@@ -155,8 +163,8 @@ StateArchive StateArchive::parse(const std::string& bytes, const std::string& wh
   in.read_bytes(sizeof kMagic, "the header");
   const auto version = in.read<std::uint32_t>("the format version");
   if (version != kFormatVersion)
-    throw StateError(fmt::format("{}: state format version {}, this build reads version {}", where, version,
-                                 kFormatVersion));
+    throw StateError(
+        fmt::format("{}: state format version {}, this build reads version {}", where, version, kFormatVersion));
   const auto count = in.read<std::uint32_t>("the entry count");
   StateArchive s;
   s.where_ = where;
@@ -169,7 +177,8 @@ StateArchive StateArchive::parse(const std::string& bytes, const std::string& wh
     if ((type == 2 || type == 3) && size != 8)
       throw StateError(fmt::format("{}: entry '{}' ({}) has {} bytes, expected 8", where, name, type_name(type), size));
     if (type == 1 && size % sizeof(double) != 0)
-      throw StateError(fmt::format("{}: vector entry '{}' has {} bytes, not a whole number of doubles", where, name, size));
+      throw StateError(
+          fmt::format("{}: vector entry '{}' has {} bytes, not a whole number of doubles", where, name, size));
     s.entries_[name] = Entry{static_cast<Type>(type), in.read_bytes(static_cast<std::size_t>(size), "entry data")};
   }
   if (!in.done())

@@ -49,8 +49,8 @@ CsvWriter CsvWriter::resume(const std::filesystem::path& path, std::size_t keep_
 
 void CsvWriter::row(const std::vector<std::string>& values) {
   if (values.size() != columns_)
-    throw std::invalid_argument(fmt::format("{}: row has {} values, header has {}",
-                                            path_.string(), values.size(), columns_));
+    throw std::invalid_argument(
+        fmt::format("{}: row has {} values, header has {}", path_.string(), values.size(), columns_));
   for (std::size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
   out_ << '\n';
   out_.flush();

@@ -18,8 +18,8 @@ namespace {
 void write_array(std::ofstream& out, const std::string& name, const Eigen::MatrixXd& data) {
   const bool vector2 = data.cols() == 2;
   const int comps = vector2 ? 3 : static_cast<int>(data.cols());
-  out << fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n",
-                     name, comps);
+  out << fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n", name,
+                     comps);
   for (Eigen::Index i = 0; i < data.rows(); ++i) {
     for (Eigen::Index j = 0; j < data.cols(); ++j) out << fmt::format("{:.10g} ", data(i, j));
     if (vector2) out << "0 ";
@@ -87,8 +87,9 @@ std::string compressed(const std::string& raw) {
     const std::size_t len = std::min(kBlock, n - b * kBlock);
     uLongf out_len = compressBound(static_cast<uLong>(len));
     std::string out(out_len, '\0');
-    if (compress2(reinterpret_cast<Bytef*>(out.data()), &out_len, reinterpret_cast<const Bytef*>(raw.data() + b * kBlock),
-                  static_cast<uLong>(len), Z_DEFAULT_COMPRESSION) != Z_OK)
+    if (compress2(reinterpret_cast<Bytef*>(out.data()), &out_len,
+                  reinterpret_cast<const Bytef*>(raw.data() + b * kBlock), static_cast<uLong>(len),
+                  Z_DEFAULT_COMPRESSION) != Z_OK)
       throw std::runtime_error("VTK output: zlib compression failed");
     put<std::uint64_t>(header, out_len);
     body.append(out.data(), out_len);
@@ -100,8 +101,8 @@ struct Appended {
   std::string xml;   // the DataArray elements, in order
   std::string data;  // their compressed bytes, in the same order
   void add(const std::string& type, const std::string& name, int components, const std::string& raw) {
-    xml += fmt::format("<DataArray type=\"{}\"{} NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
-                       type, name.empty() ? "" : fmt::format(" Name=\"{}\"", name), components, data.size());
+    xml += fmt::format("<DataArray type=\"{}\"{} NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n", type,
+                       name.empty() ? "" : fmt::format(" Name=\"{}\"", name), components, data.size());
     data += compressed(raw);
   }
   // Rows of doubles; 2 columns are written as 3 (z = 0).
@@ -124,7 +125,8 @@ void write_binary(std::ofstream& out, const VtkGrid& grid) {
   std::string points_xml, cells_xml, point_xml, cell_xml;
   {
     Eigen::MatrixXd p = Eigen::MatrixXd::Zero(grid.points.rows(), 3);
-    p.leftCols(std::min<Eigen::Index>(3, grid.points.cols())) = grid.points.leftCols(std::min<Eigen::Index>(3, grid.points.cols()));
+    p.leftCols(std::min<Eigen::Index>(3, grid.points.cols())) =
+        grid.points.leftCols(std::min<Eigen::Index>(3, grid.points.cols()));
     a.add_doubles("Points", p);
     points_xml = a.xml;
     a.xml.clear();
@@ -152,8 +154,11 @@ void write_binary(std::ofstream& out, const VtkGrid& grid) {
          "header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n"
       << "<UnstructuredGrid>\n"
       << fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", grid.points.rows(), grid.cells.size())
-      << "<Points>\n" << points_xml << "</Points>\n<Cells>\n" << cells_xml << "</Cells>\n<PointData>\n" << point_xml
-      << "</PointData>\n<CellData>\n" << cell_xml << "</CellData>\n</Piece>\n</UnstructuredGrid>\n"
+      << "<Points>\n"
+      << points_xml << "</Points>\n<Cells>\n"
+      << cells_xml << "</Cells>\n<PointData>\n"
+      << point_xml << "</PointData>\n<CellData>\n"
+      << cell_xml << "</CellData>\n</Piece>\n</UnstructuredGrid>\n"
       << "<AppendedData encoding=\"raw\">\n_";
   out.write(a.data.data(), static_cast<std::streamsize>(a.data.size()));
   out << "\n</AppendedData>\n</VTKFile>\n";

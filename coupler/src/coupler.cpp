@@ -1,5 +1,4 @@
 #include "fsi/coupling/coupler.hpp"
-#include "fsi/coupling/interface_output.hpp"
 
 #include <fmt/format.h>
 
@@ -7,19 +6,19 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <future>
 #include <limits>
+#include <optional>
+#include <tuple>
 
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
-#include "fsi/common/table_writer.hpp"
 #include "fsi/common/state.hpp"
+#include "fsi/common/table_writer.hpp"
 #include "fsi/coupling/acceleration.hpp"
 #include "fsi/coupling/checkpoint.hpp"
+#include "fsi/coupling/interface_output.hpp"
 #include "fsi/coupling/predictor.hpp"
-
-#include <future>
-#include <optional>
-#include <tuple>
 
 namespace fsi::coupling {
 namespace {
@@ -55,8 +54,8 @@ Coupler::Coupler(SolidModel& solid, FluidModel& fluid, const Scene& scene, std::
     : solid_(solid), fluid_(fluid), scene_(scene), out_dir_(std::move(out_dir)) {}
 
 Eigen::VectorXd Coupler::robin_force(const Eigen::VectorXd& traction, const Eigen::VectorXd& velocity_integral,
-                                     const Eigen::VectorXd& solid_velocity,
-                                     const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
+                                     const Eigen::VectorXd& solid_velocity, const Eigen::VectorXd& solid_displacement,
+                                     const NodalMatrix& mapped_mass) const {
   // traction = H^T f_sigma = H^T R + gamma_f (H^T f_v - M_G v_s): the fluid's force with its
   // penalty gamma_f. Algorithm 2: F* = H^T R - gamma_N1 M_G v_s (the solid adds gamma_N1 C v);
   // Algorithm 1: F* = H^T R + gamma_f (M_A1 - M_G) v_s (zero extra with the consistent M_A1).
@@ -67,7 +66,8 @@ Eigen::VectorXd Coupler::robin_force(const Eigen::VectorXd& traction, const Eige
            (gamma_f - gamma) * apply_nodal(physical_mass(solid_displacement, mapped_mass), solid_velocity);
   }
   if (gamma_f == 0) return traction;
-  return traction + gamma_f * (apply_nodal(algorithm1_mass(solid_displacement, mapped_mass), solid_velocity) - velocity_integral);
+  return traction +
+         gamma_f * (apply_nodal(algorithm1_mass(solid_displacement, mapped_mass), solid_velocity) - velocity_integral);
 }
 
 NodalMatrix Coupler::algorithm1_mass(const Eigen::VectorXd& solid_displacement, const NodalMatrix& mapped_mass) const {
@@ -140,19 +140,19 @@ struct Coupler::Step {
   Eigen::VectorXd force;  // F^(k)
   double first_residual = 0, residual = 0, first_change = 0;
   bool converged = false;
-  std::vector<double> first_r, values;  // the measures' k = 1 quantities and their values
+  std::vector<double> first_r, values;       // the measures' k = 1 quantities and their values
   Eigen::VectorXd d_iter_prev, v_iter_prev;  // the last iteration's solid interface state
-  Eigen::VectorXd x_d, x_v;  // parallel: the interface state x^(k) the fluid is given
-  double gap = 0;            // parallel: |d^(k+1) - d^(k)| / |d^(k+1)| of the last update
+  Eigen::VectorXd x_d, x_v;                  // parallel: the interface state x^(k) the fluid is given
+  double gap = 0;                            // parallel: |d^(k+1) - d^(k)| / |d^(k+1)| of the last update
   Iterate last;
 };
 
 // What one coupling iteration gives.
 struct Coupler::Update {
   Iterate iterate;
-  Eigen::VectorXd relaxed;  // F^(k+1)
-  Eigen::VectorXd next_d, next_v;  // parallel: x^(k+1)
-  double gap = 0;                  // parallel: |d^(k+1) - d^(k)| / |d^(k+1)|
+  Eigen::VectorXd relaxed;                          // F^(k+1)
+  Eigen::VectorXd next_d, next_v;                   // parallel: x^(k+1)
+  double gap = 0;                                   // parallel: |d^(k+1) - d^(k)| / |d^(k+1)|
   double stacked_change = 0, stacked_residual = 0;  // parallel: |x^(k+1) - x^(k)| scaled, and over |x^(k+1)|
   double norm = 0, change = 0;
   // The interface quantities' changes and sizes: force, traction, displacement, velocity
@@ -181,10 +181,10 @@ struct Coupler::Run {
     // and at t = 0.
     if (time.output_every > 0) interface_output.emplace(vtk_dir, c.solid_interface_, fluid_interface, time.vtk_format);
     const InterfaceMeshData& si = c.solid_interface_;
-    const Eigen::VectorXd d_s = si.initial_displacement.size() == 2 * ns ? si.initial_displacement
-                                                                          : Eigen::VectorXd::Zero(2 * ns);
-    const Eigen::VectorXd v_s = si.initial_velocity.size() == 2 * ns ? si.initial_velocity
-                                                                      : Eigen::VectorXd::Zero(2 * ns);
+    const Eigen::VectorXd d_s =
+        si.initial_displacement.size() == 2 * ns ? si.initial_displacement : Eigen::VectorXd::Zero(2 * ns);
+    const Eigen::VectorXd v_s =
+        si.initial_velocity.size() == 2 * ns ? si.initial_velocity : Eigen::VectorXd::Zero(2 * ns);
     state.v_s_prev = v_s;
     state.d_s_prev = d_s;
     state.d_f_prev = c.map_.to_fluid(d_s);
@@ -289,24 +289,27 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   for (const auto& key : scene_.root().keys())
     if (key != "scene" && key != "description" && key != "time" && key != "coupling" && key != "solid" &&
         key != "fluid")
-      throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
-                                    "coupling, solid, fluid)", scene_.root().where(key), key));
+      throw ConfigError(
+          fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
+                      "coupling, solid, fluid)",
+                      scene_.root().where(key), key));
   if (settings_.predictor != "previous")
-    log->warn("predictor '{}' ({}) can excite interface modes the iterations leave unconverged (docs/fsi.md); "
-              "'previous' is the paper's and the robust choice",
-              settings_.predictor, predictor_scheme(settings_.predictor).phrase);
+    log->warn(
+        "predictor '{}' ({}) can excite interface modes the iterations leave unconverged (docs/fsi.md); "
+        "'previous' is the paper's and the robust choice",
+        settings_.predictor, predictor_scheme(settings_.predictor).phrase);
   if (settings_.robin_auto != RobinAuto::None) automatic_robin(time);
   const double gamma = settings_.nitsche_penalty;
   const bool implicit = settings_.algorithm == Algorithm::ImplicitSolidVelocity;
   if (implicit && gamma > 0 && !solid_.supports_interface_damping())
-    throw Stop{"failed", fmt::format("Algorithm 2 needs interface damping, which solid '{}' does not support",
-                                     solid_.name())};
+    throw Stop{"failed",
+               fmt::format("Algorithm 2 needs interface damping, which solid '{}' does not support", solid_.name())};
   const auto vtk_dir = out_dir_ / "vtk";
   {
     Timer t(times_.solid);
-    solid_.configure(scene_.section("solid"), SolidSetup{time.dt, time.end, implicit ? gamma : 0.0,
-                                                         time.output_every > 0 ? vtk_dir : std::filesystem::path(),
-                                                         time.vtk_format});
+    solid_.configure(scene_.section("solid"),
+                     SolidSetup{time.dt, time.end, implicit ? gamma : 0.0,
+                                time.output_every > 0 ? vtk_dir : std::filesystem::path(), time.vtk_format});
   }
   {
     Timer t(times_.fluid);
@@ -333,16 +336,19 @@ void Coupler::automatic_robin(const TimeSettings& time) {
   const double mass_per_area = solid_.interface().mass_per_area;
   if (!(mass_per_area > 0))
     throw Stop{"failed", fmt::format("coupling.robin_auto needs the solid's mass per interface measure, which "
-                                     "solid '{}' does not report (InterfaceMesh.mass_per_area)", solid_.name())};
+                                     "solid '{}' does not report (InterfaceMesh.mass_per_area)",
+                                     solid_.name())};
   robin_auto_value_ = mass_per_area / time.dt;
   if (settings_.robin_auto != RobinAuto::Fluid) settings_.nitsche_penalty = robin_auto_value_;
   if (settings_.robin_auto != RobinAuto::Solid) settings_.fluid_penalty = robin_auto_value_;
   if (settings_.nitsche_penalty > 0 && settings_.fluid_penalty == 0)
-    throw Stop{"failed", "coupling.robin_auto: solid sets gamma_N1 > 0 with a fluid penalty of 0: give "
-                         "coupling.fluid_penalty, or robin_auto: both"};
-  logger("coupler")->info("automatic Robin parameter: m_s / |Gamma| = {:.6g}, over dt = {:.6g}: gamma_N1 = {:.6g}, "
-                          "gamma_f = {:.6g}",
-                          mass_per_area, time.dt, settings_.nitsche_penalty, settings_.fluid_penalty);
+    throw Stop{"failed",
+               "coupling.robin_auto: solid sets gamma_N1 > 0 with a fluid penalty of 0: give "
+               "coupling.fluid_penalty, or robin_auto: both"};
+  logger("coupler")->info(
+      "automatic Robin parameter: m_s / |Gamma| = {:.6g}, over dt = {:.6g}: gamma_N1 = {:.6g}, "
+      "gamma_f = {:.6g}",
+      mass_per_area, time.dt, settings_.nitsche_penalty, settings_.fluid_penalty);
 }
 
 void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface) {
@@ -362,11 +368,15 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
     if (std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b)))
       log->warn("interface measures differ: solid {} vs fluid {} (interface_measure of the two sections)", a, b);
   }
-  data["interface"] = {{"solid_nodes", ns}, {"fluid_nodes", fluid_interface.nodes()},
-                       {"max_gap", map_.max_gap()}, {"conforming", map_.conforming()},
-                       {"coincident_nodes", map_.coincident_nodes()}, {"mapping", to_string(map_.kind())}};
+  data["interface"] = {{"solid_nodes", ns},
+                       {"fluid_nodes", fluid_interface.nodes()},
+                       {"max_gap", map_.max_gap()},
+                       {"conforming", map_.conforming()},
+                       {"coincident_nodes", map_.coincident_nodes()},
+                       {"mapping", to_string(map_.kind())}};
   if (map_.kind() != MappingKind::NearestSegment) {
-    data["interface"]["rbf"] = {{"support_radius", map_.support_radius()}, {"linear_terms", map_.linear_terms()},
+    data["interface"]["rbf"] = {{"support_radius", map_.support_radius()},
+                                {"linear_terms", map_.linear_terms()},
                                 {"condition", map_.condition_estimate()}};
     log->info("mapping {}: RBF on the {} solid interface nodes, {} linear terms{}, condition estimate {:.3g}",
               to_string(map_.kind()), ns, map_.linear_terms(),
@@ -375,25 +385,32 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
   }
   if (map_.conforming()) {
     data["interface"]["permutation_error"] = map_.permutation_error();
-    log->info("conforming interface: the {} fluid nodes are the solid's (max gap {:.3g} m), H is a permutation "
-              "(max |H - P| {:.3g})", fluid_interface.nodes(), map_.max_gap(), map_.permutation_error());
+    log->info(
+        "conforming interface: the {} fluid nodes are the solid's (max gap {:.3g} m), H is a permutation "
+        "(max |H - P| {:.3g})",
+        fluid_interface.nodes(), map_.max_gap(), map_.permutation_error());
   } else {
-    log->info("non-conforming interface: {} of the {} fluid nodes coincide with one of the {} solid nodes "
-              "(within {:.3g} m), max gap to the solid's interface {:.3g} m: H interpolates",
-              map_.coincident_nodes(), fluid_interface.nodes(), ns, map_.coincidence_tolerance(), map_.max_gap());
+    log->info(
+        "non-conforming interface: {} of the {} fluid nodes coincide with one of the {} solid nodes "
+        "(within {:.3g} m), max gap to the solid's interface {:.3g} m: H interpolates",
+        map_.coincident_nodes(), fluid_interface.nodes(), ns, map_.coincidence_tolerance(), map_.max_gap());
   }
   consistent_damping_ = implicit && gamma > 0 && settings_.robin_mass == RobinMass::Consistent;
   if (consistent_damping_ && !solid_.supports_interface_mass()) {
     consistent_damping_ = false;
-    log->warn("the solid '{}' does not take the interface mass (supports_interface_mass): Algorithm 2's damping "
-              "uses its own int N^T N, and the gamma_N1 terms do not cancel exactly at convergence "
-              "(coupling.work_uncancelled in probes.csv)",
-              solid_.name());
+    log->warn(
+        "the solid '{}' does not take the interface mass (supports_interface_mass): Algorithm 2's damping "
+        "uses its own int N^T N, and the gamma_N1 terms do not cancel exactly at convergence "
+        "(coupling.work_uncancelled in probes.csv)",
+        solid_.name());
   }
-  data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)}, {"gamma_n1", gamma},
+  data["coupling"] = {{"algorithm", static_cast<int>(settings_.algorithm)},
+                      {"gamma_n1", gamma},
                       {"fluid_penalty", settings_.fluid_penalty},
-                      {"gamma_n2", settings_.nitsche_symmetry}, {"relaxation", settings_.relaxation},
-                      {"max_iterations", settings_.max_iterations}, {"tolerance", settings_.tolerance},
+                      {"gamma_n2", settings_.nitsche_symmetry},
+                      {"relaxation", settings_.relaxation},
+                      {"max_iterations", settings_.max_iterations},
+                      {"tolerance", settings_.tolerance},
                       {"acceleration", settings_.acceleration},
                       {"robin_mass", to_string(settings_.robin_mass)}};
   nlohmann::json measures = nlohmann::json::array();
@@ -412,11 +429,11 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
   if (accelerator_scheme(settings_.acceleration).quasi_newton) {
     const char* filters[] = {"qr1", "qr2", "qr3"};
     const char* restarts[] = {"none", "rs-0", "rs-ls", "rs-svd"};
-    data["coupling"]["iqn"] = {{"reuse_steps", settings_.reuse_steps},
-                               {"filter", settings_.iqn_filter},
-                               {"filter_type", filters[static_cast<int>(settings_.iqn_filter_type)]},
-                               {"preconditioner", settings_.iqn_preconditioner == Preconditioner::None ? "none"
-                                                                                                      : "residual-sum"}};
+    data["coupling"]["iqn"] = {
+        {"reuse_steps", settings_.reuse_steps},
+        {"filter", settings_.iqn_filter},
+        {"filter_type", filters[static_cast<int>(settings_.iqn_filter_type)]},
+        {"preconditioner", settings_.iqn_preconditioner == Preconditioner::None ? "none" : "residual-sum"}};
     if (settings_.acceleration == "iqn-imvj")
       data["coupling"]["iqn"]["imvj"] = {{"restart", restarts[static_cast<int>(settings_.imvj_restart)]},
                                          {"chunk_size", settings_.imvj_chunk_size},
@@ -424,8 +441,8 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
                                          {"truncation", settings_.imvj_truncation}};
   }
   log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
-            to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations,
-            settings_.tolerance, ns, fluid_interface.nodes());
+            to_string(settings_.algorithm), gamma, settings_.relaxation, settings_.max_iterations, settings_.tolerance,
+            ns, fluid_interface.nodes());
   if (settings_.fluid_penalty != gamma)
     log->info("the fluid's Nitsche penalty gamma_f = {} is set apart from gamma_N1{}", settings_.fluid_penalty,
               implicit ? "" : " (Algorithm 1 uses gamma_f only: gamma_N1 has no effect)");
@@ -449,18 +466,20 @@ void Coupler::write_output(Run& r, const StepInfo& info, const InterfaceFields& 
     for (const auto& [side, ok, who] : {std::tuple{"solid", solid_.supports_output(), solid_.name()},
                                         std::tuple{"fluid", fluid_.supports_output(), fluid_.name()}})
       if (ok && r.files_written[side] == 0)
-        r.log->warn("time.output_every = {}: the {} '{}' wrote no VTK in {} requests (does its section turn "
-                    "output off? {})",
-                    r.time.output_every, side, who, r.output_requests,
-                    std::string(side) == "solid" ? "solid.output_every" : "fluid.output.vtk_every");
+        r.log->warn(
+            "time.output_every = {}: the {} '{}' wrote no VTK in {} requests (does its section turn "
+            "output off? {})",
+            r.time.output_every, side, who, r.output_requests,
+            std::string(side) == "solid" ? "solid.output_every" : "fluid.output.vtk_every");
 }
 
 NodalMatrix Coupler::map_mass(Run& r, const FluidLoads& loads) {
   if (loads.interface_mass.rows() == 0) {
     if (!r.warned_no_fluid_mass && r.gamma > 0 && settings_.robin_mass == RobinMass::Consistent)
-      r.log->warn("the fluid '{}' does not send its interface mass M_f: the gamma_N1 terms use the solid's "
-                  "polyline int N^T N and cancel at convergence only where it equals H^T M_f H",
-                  fluid_.name());
+      r.log->warn(
+          "the fluid '{}' does not send its interface mass M_f: the gamma_N1 terms use the solid's "
+          "polyline int N^T N and cancel at convergence only where it equals H^T M_f H",
+          fluid_.name());
     r.warned_no_fluid_mass = true;
     return NodalMatrix();
   }
@@ -484,8 +503,11 @@ void Coupler::start_state(Run& r) {
   else
     initial_state(r);
   if (r.checkpoints)
-    r.data["checkpoints"] = {{"every", r.time.checkpoint_every}, {"keep", r.time.checkpoint_keep}, {"written", 0},
-                             {"seconds", 0.0}, {"folder", (out_dir_ / "checkpoints").string()}};
+    r.data["checkpoints"] = {{"every", r.time.checkpoint_every},
+                             {"keep", r.time.checkpoint_keep},
+                             {"written", 0},
+                             {"seconds", 0.0},
+                             {"folder", (out_dir_ / "checkpoints").string()}};
   if (r.restart) r.data["resumed_from_step"] = r.restart->step;
   r.data["wall_time_earlier_segments"] = r.wall_before;
 }
@@ -523,7 +545,8 @@ void Coupler::load_restart(Run& r) {
   auto diffs = parameter_differences(restart.manifest.value("parameters", nlohmann::json::object()), r.parameters);
   // A resumed run may be extended: time.end is the one key that may differ.
   if (!r.at_fork) {
-    const auto end = std::find_if(diffs.begin(), diffs.end(), [](const std::string& d) { return d.rfind("time.end:", 0) == 0; });
+    const auto end =
+        std::find_if(diffs.begin(), diffs.end(), [](const std::string& d) { return d.rfind("time.end:", 0) == 0; });
     if (end != diffs.end()) {
       r.log->info("extended: {}", *end);
       r.data["extended"] = *end;
@@ -552,10 +575,11 @@ void Coupler::load_restart(Run& r) {
     Timer t(times_.fluid);
     fluid_.load_checkpoint(step, restart.time, restart.parts.at("fluid"));
   }
-  const StateArchive c = StateArchive::parse(restart.parts.at("coupler"), "coupler checkpoint of step " +
-                                                                               std::to_string(step));
+  const StateArchive c =
+      StateArchive::parse(restart.parts.at("coupler"), "coupler checkpoint of step " + std::to_string(step));
   if (c.integer("step") != step)
-    throw Stop{"failed", fmt::format("checkpoint {}: coupler part is of step {}", restart.dir.string(), c.integer("step"))};
+    throw Stop{"failed",
+               fmt::format("checkpoint {}: coupler part is of step {}", restart.dir.string(), c.integer("step"))};
   read_coupler_state(r, c);
   if (r.at_fork) convert_forked_predictor(r, c);
   r.wall_before = restart.manifest.value("wall_seconds", 0.0);
@@ -586,15 +610,17 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
     for (Eigen::Index k = 0; k < values.size(); ++k) {
       const auto row = static_cast<Eigen::Index>(rows[k]), col = static_cast<Eigen::Index>(cols[k]);
       if (row < 0 || row >= ns || col < 0 || col >= ns)
-        throw Stop{"failed", fmt::format("checkpoint {}: coupler mapped_mass entry ({}, {}) outside {} nodes", dir,
-                                         row, col, ns)};
+        throw Stop{"failed", fmt::format("checkpoint {}: coupler mapped_mass entry ({}, {}) outside {} nodes", dir, row,
+                                         col, ns)};
       t.emplace_back(row, col, values[k]);
     }
     st.mapped_mass.resize(ns, ns);
     st.mapped_mass.setFromTriplets(t.begin(), t.end());
   } else if (r.implicit && r.gamma > 0) {
-    r.log->warn("checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
-                "solid's own int N^T N", dir, r.restart->step + 1);
+    r.log->warn(
+        "checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
+        "solid's own int N^T N",
+        dir, r.restart->step + 1);
   }
   st.work_solid = c.real("work_solid");
   st.work_fluid = c.real("work_fluid");
@@ -612,7 +638,8 @@ void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
   // felt plus gamma_N1 C v_n. Forked into another algorithm or gamma_N1, convert it (the
   // predictor of the next step), and drop the accelerator's reused secant pairs (they
   // live in the old force's space).
-  const auto& old = r.restart->manifest.value("parameters", nlohmann::json::object()).value("coupling", nlohmann::json::object());
+  const auto& old =
+      r.restart->manifest.value("parameters", nlohmann::json::object()).value("coupling", nlohmann::json::object());
   auto number = [](const nlohmann::json& j, const char* key, double fallback) {
     if (!j.contains(key)) return fallback;
     const auto& v = j.at(key);
@@ -625,8 +652,10 @@ void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
   State& st = r.state;
   const NodalMatrix c_mass = st.mapped_mass.rows() > 0 ? st.mapped_mass : nodal_interface_mass(solid_interface_, {});
   if (!c.has("v_s_prev"))
-    r.log->warn("checkpoint {} holds no interface velocity (an earlier version): the first step's predictor "
-                "keeps the old algorithm's force", r.restart->dir.string());
+    r.log->warn(
+        "checkpoint {} holds no interface velocity (an earlier version): the first step's predictor "
+        "keeps the old algorithm's force",
+        r.restart->dir.string());
   else {
     for (Eigen::VectorXd* f : {&st.force_n, &st.force_nm1, &st.force_nm2, &st.force_nm3}) {
       if (old_algorithm == 2 && old_gamma > 0) *f -= old_gamma * apply_nodal(c_mass, st.v_s_prev);
@@ -635,9 +664,10 @@ void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
     r.data["forked_from"]["predictor_converted"] = true;
   }
   r.accelerator = make_accelerator(settings_);
-  r.log->info("forked from algorithm {} (gamma_N1 {}) into algorithm {} (gamma_N1 {}): the force predictor "
-              "converted, the reused secant pairs dropped",
-              old_algorithm, old_gamma, static_cast<int>(settings_.algorithm), gamma);
+  r.log->info(
+      "forked from algorithm {} (gamma_N1 {}) into algorithm {} (gamma_N1 {}): the force predictor "
+      "converted, the reused secant pairs dropped",
+      old_algorithm, old_gamma, static_cast<int>(settings_.algorithm), gamma);
 }
 
 void Coupler::initial_state(Run& r) {
@@ -662,10 +692,19 @@ void Coupler::initial_state(Run& r) {
 }
 
 void Coupler::open_tables(Run& r) {
-  std::vector<std::string> iteration_columns{"step",          "time",          "iteration",         "residual",
-                                             "force_norm",    "solid_newton",  "fluid_iterations",  "traction_change",
-                                             "traction_norm", "displacement_change", "displacement_norm",
-                                             "velocity_change", "velocity_norm"};
+  std::vector<std::string> iteration_columns{"step",
+                                             "time",
+                                             "iteration",
+                                             "residual",
+                                             "force_norm",
+                                             "solid_newton",
+                                             "fluid_iterations",
+                                             "traction_change",
+                                             "traction_norm",
+                                             "displacement_change",
+                                             "displacement_norm",
+                                             "velocity_change",
+                                             "velocity_norm"};
   for (const auto& m : settings_.measures) iteration_columns.push_back(m.name());
   if (settings_.scheme == CouplingScheme::Parallel) iteration_columns.push_back("interface_gap");
   const bool resume_tables = r.restart && !r.at_fork;
@@ -711,8 +750,7 @@ Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
   if (settings_.scheme == CouplingScheme::Parallel) return parallel_iteration(r, step);
   const int n = step.n, k = step.k;
   const double gamma = r.gamma;
-  if (interrupt_flag())
-    throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
+  if (interrupt_flag()) throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
   const StepInfo info{step.t_np1, r.time.dt, n, k};
   Update u;
   Iterate& it = u.iterate;
@@ -750,9 +788,10 @@ Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
     // without its penalty part), and its mismatch with what the solid felt: its load
     // F^(k) minus its own Robin damping gamma C v_s.
     const double gamma_f = settings_.fluid_penalty;
-    it.traction = gamma_f > 0 ? Eigen::VectorXd(fs - gamma_f * (fv - apply_nodal(physical_mass(s.interface_displacement, it.mass),
-                                                                                  s.interface_velocity)))
-                              : fs;
+    it.traction =
+        gamma_f > 0 ? Eigen::VectorXd(fs - gamma_f * (fv - apply_nodal(physical_mass(s.interface_displacement, it.mass),
+                                                                       s.interface_velocity)))
+                    : fs;
     traction_change = it.traction + step.force;
     if (it.damping.rows() > 0) traction_change -= gamma * apply_nodal(it.damping, s.interface_velocity);
     // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
@@ -787,8 +826,7 @@ double Coupler::parallel_gap_limit() const {
 // [d_s - d^(k); v_s - v^(k); -F*(x^(k)) - F^(k)].
 Coupler::Update Coupler::parallel_iteration(Run& r, Step& step) {
   const int n = step.n, k = step.k;
-  if (interrupt_flag())
-    throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
+  if (interrupt_flag()) throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
   const StepInfo info{step.t_np1, r.time.dt, n, k};
   Update u;
   Iterate& it = u.iterate;
@@ -828,9 +866,9 @@ Coupler::Update Coupler::parallel_iteration(Run& r, Step& step) {
     // F* of the interface state the fluid was given.
     const Eigen::VectorXd f_star = robin_force(fs, fv, step.x_v, step.x_d, it.mass);
     const double gamma_f = settings_.fluid_penalty;
-    it.traction = gamma_f > 0 ? Eigen::VectorXd(fs - gamma_f * (fv - apply_nodal(physical_mass(step.x_d, it.mass),
-                                                                                  step.x_v)))
-                              : fs;
+    it.traction = gamma_f > 0
+                      ? Eigen::VectorXd(fs - gamma_f * (fv - apply_nodal(physical_mass(step.x_d, it.mass), step.x_v)))
+                      : fs;
     traction_change = it.traction + step.force;
     if (it.damping.rows() > 0) traction_change -= r.gamma * apply_nodal(it.damping, s.interface_velocity);
     stacked_update(r, step, u, -f_star - step.force);
@@ -908,11 +946,19 @@ bool Coupler::measures_met(Step& step, const Update& u) const {
 
 bool Coupler::finish_iteration(Run& r, Step& step, const Update& u, bool met) {
   const int n = step.n, k = step.k;
-  std::vector<double> row_values{double(n),          step.t_np1,         double(k),          step.residual,
-                                 u.norm,             double(u.iterate.s.newton_iterations),
+  std::vector<double> row_values{double(n),
+                                 step.t_np1,
+                                 double(k),
+                                 step.residual,
+                                 u.norm,
+                                 double(u.iterate.s.newton_iterations),
                                  double(u.iterate.loads.nonlinear_iterations),
-                                 u.r_quantity[1],    u.q_quantity[1],    u.r_quantity[2],    u.q_quantity[2],
-                                 u.r_quantity[3],    u.q_quantity[3]};
+                                 u.r_quantity[1],
+                                 u.q_quantity[1],
+                                 u.r_quantity[2],
+                                 u.q_quantity[2],
+                                 u.r_quantity[3],
+                                 u.q_quantity[3]};
   row_values.insert(row_values.end(), step.values.begin(), step.values.end());
   if (settings_.scheme == CouplingScheme::Parallel) row_values.push_back(u.gap);
   r.iterations.row(row_values);
@@ -936,12 +982,12 @@ bool Coupler::finish_iteration(Run& r, Step& step, const Update& u, bool met) {
   // Geometric growth keeps the relative residual constant: watch the absolute change.
   if (k > 1 && (residual > settings_.divergence_factor * std::max(step.first_residual, settings_.residual_floor) ||
                 change > settings_.divergence_factor * std::max(step.first_change, settings_.residual_floor)))
-    throw Stop{"diverged", fmt::format("coupling residual grew: {} from {:.3e} to {:.3e} "
-                                       "(relative {:.3e} to {:.3e}) at step {} iteration {} "
-                                       "(relaxation {} above the stability limit?)",
-                                       parallel ? "|x^(k+1) - x^(k)| (scaled [d; v; F])" : "|F^(k+1) - F^(k)|",
-                                       step.first_change, change, step.first_residual, residual, n, k,
-                                       settings_.relaxation)};
+    throw Stop{"diverged",
+               fmt::format("coupling residual grew: {} from {:.3e} to {:.3e} "
+                           "(relative {:.3e} to {:.3e}) at step {} iteration {} "
+                           "(relaxation {} above the stability limit?)",
+                           parallel ? "|x^(k+1) - x^(k)| (scaled [d; v; F])" : "|F^(k+1) - F^(k)|", step.first_change,
+                           change, step.first_residual, residual, n, k, settings_.relaxation)};
   return false;
 }
 
@@ -998,11 +1044,11 @@ void Coupler::accept_step(Run& r, Step& step) {
   r.timing.row(std::vector<double>{double(n), t_np1, r.wall_before + (now() - r.segment_start), times_.fluid,
                                    times_.solid, double(used)});
   if (r.time.output_every > 0 && n % r.time.output_every == 0)
-    write_output(r, accepted, InterfaceFields{last.s.interface_displacement, last.s.interface_velocity,
-                                              last.force_applied, map_.to_solid(last.loads.traction_force),
-                                              map_.to_solid(last.loads.velocity_integral), last.d_f,
-                                              map_.to_fluid(last.s.interface_velocity), last.loads.traction_force,
-                                              last.loads.velocity_integral});
+    write_output(r, accepted,
+                 InterfaceFields{last.s.interface_displacement, last.s.interface_velocity, last.force_applied,
+                                 map_.to_solid(last.loads.traction_force), map_.to_solid(last.loads.velocity_integral),
+                                 last.d_f, map_.to_fluid(last.s.interface_velocity), last.loads.traction_force,
+                                 last.loads.velocity_integral});
   r.accelerator->end_step();
   r.state.accept_force(step.force);
   r.out.steps = n;
@@ -1037,8 +1083,8 @@ void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::strin
   const double g = r.implicit ? gamma : settings_.fluid_penalty;  // the parameter of C's term
   if (g > 0) {
     const NodalMatrix m_phys = physical_mass(s.interface_displacement, last.mass);
-    const NodalMatrix c_cfg = r.implicit ? solid_damping_mass(last.mass)
-                                         : algorithm1_mass(s.interface_displacement, last.mass);
+    const NodalMatrix c_cfg =
+        r.implicit ? solid_damping_mass(last.mass) : algorithm1_mass(s.interface_displacement, last.mass);
     uncancelled = g * (apply_nodal(m_phys, v) - apply_nodal(c_cfg, v)).dot(dd);
   }
   st.work_uncancelled += uncancelled;
@@ -1100,8 +1146,8 @@ void Coupler::save_checkpoint(Run& r, int n, double t_np1) {
   info["written"] = info.value("written", 0) + 1;
   info["last_step"] = n;
   info["last_bytes"] = written.bytes;
-  info["parts_bytes"] = {{"solid", parts["solid"].size()}, {"fluid", parts["fluid"].size()},
-                         {"coupler", parts["coupler"].size()}};
+  info["parts_bytes"] = {
+      {"solid", parts["solid"].size()}, {"fluid", parts["fluid"].size()}, {"coupler", parts["coupler"].size()}};
 }
 
 }  // namespace fsi::coupling

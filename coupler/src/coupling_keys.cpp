@@ -19,8 +19,7 @@ std::vector<std::string> names_of(const Schemes& schemes) {
 std::string reuse_default_text() {
   std::string out;
   for (const auto& s : accelerator_schemes())
-    if (s.quasi_newton)
-      out += (out.empty() ? "" : ", ") + std::to_string(s.default_reuse_steps) + " (" + s.name + ")";
+    if (s.quasi_newton) out += (out.empty() ? "" : ", ") + std::to_string(s.default_reuse_steps) + " (" + s.name + ")";
   return out;
 }
 
@@ -29,40 +28,47 @@ schema::Key declare_coupling() {
   Key coupling = section(
       "coupling", "the coupling scheme (the coupler); present = a coupled run of solid and fluid",
       {
-      integer("algorithm", "1 = explicit solid velocity in the Robin term (Algorithm 1), 2 = implicit, adds the "
-                           "damping M_fs = gamma_N1 int N^T N (Algorithm 2)")
-          .req()
-          .values({"1", "2"}),
-      choice("scheme", {"serial", "parallel"},
-             "serial: the solid, then the fluid with its new interface state (the paper); parallel: both at "
-             "once (Jacobi), accelerated on the stacked interface state and force")
-          .def("serial"),
-      number("gamma_n1", "Nitsche penalty gamma_N1 (the Robin parameter)").req().ge(0),
-      choice("robin_auto", {"none", "solid", "fluid", "both"},
-             "the Robin parameter from the solid's mass per interface measure over dt, (m_s / |Gamma|) / dt, "
-             "instead of gamma_n1 (solid: Algorithm 2's damping), of fluid_penalty (fluid), or of both")
-          .def("none"),
-      number("fluid_penalty",
-             "the fluid's Nitsche penalty gamma_f (weak v_f = v_s); default gamma_n1 (the paper: one parameter). "
-             "Set apart, Algorithm 2's converged solution does not depend on gamma_n1; Algorithm 1 uses gamma_f only")
-          .def_computed("gamma_n1")
-          .ge(0),
-      number("gamma_n2", "Nitsche symmetry switch: +1 symmetric, -1 unsymmetric (the paper)")
-          .def("-1")
-          .values({"1", "-1"}),
-      number("relaxation", "beta: F^(k+1) = -beta F* + (1 - beta) F^(k); below 2 with Algorithm 1").req().gt(0).says("(beta) must be > 0"),
-      choice("predictor", names_of(predictor_schemes()),
-             "force predictor, extrapolating the last 1-4 accepted forces: F_n (the paper), 2 F_n - F_(n-1), "
-             "3 F_n - 3 F_(n-1) + F_(n-2), or 4 F_n - 6 F_(n-1) + 4 F_(n-2) - F_(n-3)")
-          .def("previous"),
-      choice("acceleration", names_of(accelerator_schemes()),
-             "constant beta (the paper), Aitken dynamic relaxation, or interface quasi-Newton: IQN-ILS (least "
-             "squares) or IQN-IMVJ (multi-vector Jacobian carried over the steps)")
-          .def("constant"),
-      section("iqn", "interface quasi-Newton options (IQN-ILS, IQN-IMVJ; preCICE's semantics)",
+          integer("algorithm",
+                  "1 = explicit solid velocity in the Robin term (Algorithm 1), 2 = implicit, adds the "
+                  "damping M_fs = gamma_N1 int N^T N (Algorithm 2)")
+              .req()
+              .values({"1", "2"}),
+          choice("scheme", {"serial", "parallel"},
+                 "serial: the solid, then the fluid with its new interface state (the paper); parallel: both at "
+                 "once (Jacobi), accelerated on the stacked interface state and force")
+              .def("serial"),
+          number("gamma_n1", "Nitsche penalty gamma_N1 (the Robin parameter)").req().ge(0),
+          choice("robin_auto", {"none", "solid", "fluid", "both"},
+                 "the Robin parameter from the solid's mass per interface measure over dt, (m_s / |Gamma|) / dt, "
+                 "instead of gamma_n1 (solid: Algorithm 2's damping), of fluid_penalty (fluid), or of both")
+              .def("none"),
+          number(
+              "fluid_penalty",
+              "the fluid's Nitsche penalty gamma_f (weak v_f = v_s); default gamma_n1 (the paper: one parameter). "
+              "Set apart, Algorithm 2's converged solution does not depend on gamma_n1; Algorithm 1 uses gamma_f only")
+              .def_computed("gamma_n1")
+              .ge(0),
+          number("gamma_n2", "Nitsche symmetry switch: +1 symmetric, -1 unsymmetric (the paper)")
+              .def("-1")
+              .values({"1", "-1"}),
+          number("relaxation", "beta: F^(k+1) = -beta F* + (1 - beta) F^(k); below 2 with Algorithm 1")
+              .req()
+              .gt(0)
+              .says("(beta) must be > 0"),
+          choice("predictor", names_of(predictor_schemes()),
+                 "force predictor, extrapolating the last 1-4 accepted forces: F_n (the paper), 2 F_n - F_(n-1), "
+                 "3 F_n - 3 F_(n-1) + F_(n-2), or 4 F_n - 6 F_(n-1) + 4 F_(n-2) - F_(n-3)")
+              .def("previous"),
+          choice("acceleration", names_of(accelerator_schemes()),
+                 "constant beta (the paper), Aitken dynamic relaxation, or interface quasi-Newton: IQN-ILS (least "
+                 "squares) or IQN-IMVJ (multi-vector Jacobian carried over the steps)")
+              .def("constant"),
+          section(
+              "iqn", "interface quasi-Newton options (IQN-ILS, IQN-IMVJ; preCICE's semantics)",
               {
-                  integer("reuse_steps", "secant pairs are kept from the last N steps (IQN-IMVJ carries them in "
-                                         "its Jacobian instead)")
+                  integer("reuse_steps",
+                          "secant pairs are kept from the last N steps (IQN-IMVJ carries them in "
+                          "its Jacobian instead)")
                       .def_computed(reuse_default_text())
                       .ge(0),
                   number("filter", "the filter's limit eps").def("0.001").gt(0).lt(1),
@@ -84,26 +90,27 @@ schema::Key declare_coupling() {
                                      "truncated SVD of the accumulated Jacobian")
                                   .def("none"),
                               integer("chunk_size", "steps between restarts").def("8").ge(1).in_unit("steps"),
-                              integer("restart_reuse_steps", "rs-ls: the steps whose secant pairs define the "
-                                                             "restart Jacobian")
+                              integer("restart_reuse_steps",
+                                      "rs-ls: the steps whose secant pairs define the "
+                                      "restart Jacobian")
                                   .def("8")
                                   .ge(1)
                                   .in_unit("steps"),
-                              number("truncation", "rs-svd: singular values below this share of the largest "
-                                                   "are dropped")
+                              number("truncation",
+                                     "rs-svd: singular values below this share of the largest "
+                                     "are dropped")
                                   .def("0.0001")
                                   .ge(0)
                                   .lt(1),
                           })
                       .only_when("coupling.acceleration", {"iqn-imvj"}, "constant"),
               })
-          .only_when("acceleration", {"iqn-ils", "iqn-imvj"}, "constant"),
-      section("iterations", "coupling iterations per time step",
+              .only_when("acceleration", {"iqn-ils", "iqn-imvj"}, "constant"),
+          section(
+              "iterations", "coupling iterations per time step",
               {
                   integer("max", "k_max, coupling iterations per step").req().ge(1),
-                  number("tolerance", "relative interface residual target; 0 = always k_max iterations")
-                      .def("0")
-                      .ge(0),
+                  number("tolerance", "relative interface residual target; 0 = always k_max iterations").def("0").ge(0),
                   boolean("stop_if_not_converged", "a step that misses the tolerance ends the run").def("true"),
                   number("divergence_factor", "a residual this many times the step's first one = diverged")
                       .def("10000")
@@ -122,23 +129,24 @@ schema::Key declare_coupling() {
                                }),
                   choice("combine", {"all", "any"}, "converged when all measures hold, or any").def("all"),
               })
-          .req(),
-      choice("robin_mass", {"consistent", "solid"},
-             "interface mass of the gamma_N1 terms on the solid side: the fluid's H^T M_f H in its current "
-             "configuration (cancels exactly at convergence), or the solid's own int N^T N (earlier behaviour)")
-          .def("consistent"),
-      choice("mapping", {"nearest-segment", "rbf-tps", "rbf-wendland-c2"},
-             "interface mapping, displacement and velocity consistent (H), forces by H^T: projection on the "
-             "solid's interface segments, or radial basis functions on the solid's nodes with a linear term "
-             "(exact for affine fields): thin-plate splines, or Wendland C2 of radius support_radius")
-          .def("nearest-segment"),
-      number("support_radius", "rbf-wendland-c2: the support radius; default 50 x the largest distance from a "
-                               "solid interface node to its nearest neighbour")
-          .def_computed("50 x node spacing")
-          .gt(0)
-          .in_unit("m")
-          .only_when("mapping", {"rbf-wendland-c2"}, "nearest-segment"),
-      number("force_limit", "an interface force above this = diverged").def("1e12").gt(0).in_unit("N"),
+              .req(),
+          choice("robin_mass", {"consistent", "solid"},
+                 "interface mass of the gamma_N1 terms on the solid side: the fluid's H^T M_f H in its current "
+                 "configuration (cancels exactly at convergence), or the solid's own int N^T N (earlier behaviour)")
+              .def("consistent"),
+          choice("mapping", {"nearest-segment", "rbf-tps", "rbf-wendland-c2"},
+                 "interface mapping, displacement and velocity consistent (H), forces by H^T: projection on the "
+                 "solid's interface segments, or radial basis functions on the solid's nodes with a linear term "
+                 "(exact for affine fields): thin-plate splines, or Wendland C2 of radius support_radius")
+              .def("nearest-segment"),
+          number("support_radius",
+                 "rbf-wendland-c2: the support radius; default 50 x the largest distance from a "
+                 "solid interface node to its nearest neighbour")
+              .def_computed("50 x node spacing")
+              .gt(0)
+              .in_unit("m")
+              .only_when("mapping", {"rbf-wendland-c2"}, "nearest-segment"),
+          number("force_limit", "an interface force above this = diverged").def("1e12").gt(0).in_unit("N"),
 
       });
   coupling.check = [](const Scene& scene) { (void)read_coupling(scene.section("coupling")); };

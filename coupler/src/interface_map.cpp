@@ -4,7 +4,6 @@
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -31,7 +30,8 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
     return;
   }
   if (ns == 0 || nf == 0)
-    throw std::invalid_argument(fmt::format("interface mismatch: the solid has {} interface nodes, the fluid {}", ns, nf));
+    throw std::invalid_argument(
+        fmt::format("interface mismatch: the solid has {} interface nodes, the fluid {}", ns, nf));
   std::vector<Eigen::Triplet<double>> t, ts;
   for (Eigen::Index i = 0; i < nf; ++i) {
     const Eigen::Vector2d p = fluid.coordinates.row(i).transpose();
@@ -129,8 +129,8 @@ void InterfaceMap::build_rbf(const InterfaceMeshData& solid, const InterfaceMesh
   const bool wendland = kind_ == MappingKind::RbfWendlandC2;
   if (wendland) {
     support_radius_ = mapping.support_radius > 0 ? mapping.support_radius
-                      : spacing > 0             ? MappingSettings::support_factor * spacing * scale
-                                                : scale;
+                      : spacing > 0              ? MappingSettings::support_factor * spacing * scale
+                                                 : scale;
   }
   const double radius = support_radius_ / scale;
   auto phi = [&](double r) {
@@ -212,8 +212,9 @@ void InterfaceMap::detect_conforming(const InterfaceMeshData& solid, const Inter
 
 NodalMatrix InterfaceMap::mass_to_solid(const NodalMatrix& fluid_mass) const {
   if (fluid_mass.rows() != hs_.rows() || fluid_mass.cols() != hs_.rows())
-    throw std::invalid_argument(fmt::format("interface mass of the fluid is {} x {}, expected {} x {} (its interface nodes)",
-                                            fluid_mass.rows(), fluid_mass.cols(), hs_.rows(), hs_.rows()));
+    throw std::invalid_argument(
+        fmt::format("interface mass of the fluid is {} x {}, expected {} x {} (its interface nodes)", fluid_mass.rows(),
+                    fluid_mass.cols(), hs_.rows(), hs_.rows()));
   if (hs_dense_.size() > 0) {  // RBF: H is dense, a dense product is much faster than a sparse one
     const Eigen::MatrixXd mh = fluid_mass * hs_dense_;
     const Eigen::MatrixXd dense = hs_dense_.transpose() * mh;

@@ -24,7 +24,8 @@ VtkGrid grid_of(const InterfaceMeshData& mesh) {
 }
 
 Eigen::MatrixXd nodal(const Eigen::VectorXd& v, Eigen::Index n, const char* name) {
-  if (v.size() != 2 * n) throw std::invalid_argument(std::string("interface output: '") + name + "' has the wrong size");
+  if (v.size() != 2 * n)
+    throw std::invalid_argument(std::string("interface output: '") + name + "' has the wrong size");
   Eigen::MatrixXd m(n, 2);
   for (Eigen::Index i = 0; i < n; ++i) m.row(i) << v[2 * i], v[2 * i + 1];
   return m;

@@ -17,9 +17,9 @@
 #include <fstream>
 
 #include "fsi/common/log.hpp"
-#include "fsi/common/version.hpp"
 #include "fsi/common/process.hpp"
 #include "fsi/common/run_report.hpp"
+#include "fsi/common/version.hpp"
 #include "fsi/coupling/coupler.hpp"
 #include "fsi/protocol/client.hpp"
 #include "fsi/protocol/remote.hpp"
@@ -75,21 +75,17 @@ int parse_options(int argc, char** argv, Options& o) {
   app.set_version_flag("--version", fsi::version_line("coupler") + "\nprotocol fsi.v1, version " +
                                         std::to_string(fsi::protocol::kProtocolVersion));
   app.add_option("scene", o.scene_path, "scene file (configs/*.yaml)")->required();
-  app.add_option("--solid", o.solid_endpoint, "solid server endpoint, e.g. tcp://127.0.0.1:5555")
-      ->required();
-  app.add_option("--fluid", o.fluid_endpoint, "fluid server endpoint, e.g. tcp://127.0.0.1:5556")
-      ->required();
+  app.add_option("--solid", o.solid_endpoint, "solid server endpoint, e.g. tcp://127.0.0.1:5555")->required();
+  app.add_option("--fluid", o.fluid_endpoint, "fluid server endpoint, e.g. tcp://127.0.0.1:5556")->required();
   app.add_option("--out", o.out_dir, "output folder");
   app.add_option("--set", o.overrides, "override a scene key: dotted.key=value");
-  app.add_option("--timeout", o.timeout,
-                 "seconds to wait for any reply (a dead peer is detected at once)");
+  app.add_option("--timeout", o.timeout, "seconds to wait for any reply (a dead peer is detected at once)");
   app.add_option("--connect-timeout", o.connect_timeout, "seconds to wait for the handshake");
   app.add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
   app.add_flag("--force", o.force, "replace the results of an earlier run in --out");
-  app.add_flag(
-      "--recoverable", o.recoverable,
-      "exit with code 75 (instead of 1) when a server dies or stops answering, so that the "
-      "launcher can restart it and resume (fsi run --recover)");
+  app.add_flag("--recoverable", o.recoverable,
+               "exit with code 75 (instead of 1) when a server dies or stops answering, so that the "
+               "launcher can restart it and resume (fsi run --recover)");
   app.add_flag("--resume-or-restart", o.fresh_start,
                "with --resume: start again from step 0 when there is no checkpoint yet");
   app.add_flag("--out-ready", o.out_ready, "the launcher has prepared --out")->group("");
@@ -97,8 +93,7 @@ int parse_options(int argc, char** argv, Options& o) {
                  "encrypt and authenticate with ZeroMQ CURVE: the folder made by `fsi keys DIR` "
                  "(coupler.key_secret, "
                  "server.key)");
-  app.add_option("--generate-keys", o.generate_keys,
-                 "write a new CURVE key folder and exit (what `fsi keys` runs)")
+  app.add_option("--generate-keys", o.generate_keys, "write a new CURVE key folder and exit (what `fsi keys` runs)")
       ->group("");
   if (const int code = generate_keys_if_asked(argc, argv); code >= 0) return code;
   try {
@@ -112,22 +107,19 @@ int parse_options(int argc, char** argv, Options& o) {
 // Connects both servers (handshake), with the reply timeout and CURVE keys of the options.
 void connect_servers(const Options& o, Servers& servers, fsi::RunReport& report, const Logger& log) {
   const auto connect = std::chrono::milliseconds(static_cast<long>(o.connect_timeout * 1000));
-  const auto keys = o.curve_keys.empty() ? fsi::transport::CurveKeys{}
-                                         : fsi::transport::load_curve_keys(o.curve_keys, "coupler");
+  const auto keys =
+      o.curve_keys.empty() ? fsi::transport::CurveKeys{} : fsi::transport::load_curve_keys(o.curve_keys, "coupler");
   const auto wait = std::chrono::milliseconds(static_cast<long>(o.timeout * 1000));
   servers.solid = std::make_unique<fsi::protocol::RemoteSolid>(
-      std::make_unique<fsi::protocol::ProtocolClient>(o.solid_endpoint, "solid server", connect,
-                                                      keys));
+      std::make_unique<fsi::protocol::ProtocolClient>(o.solid_endpoint, "solid server", connect, keys));
   servers.fluid = std::make_unique<fsi::protocol::RemoteFluid>(
-      std::make_unique<fsi::protocol::ProtocolClient>(o.fluid_endpoint, "fluid server", connect,
-                                                      keys));
+      std::make_unique<fsi::protocol::ProtocolClient>(o.fluid_endpoint, "fluid server", connect, keys));
   servers.solid->client().set_timeout(wait);
   servers.fluid->client().set_timeout(wait);
   log->info("connected: solid '{}' at {}, fluid '{}' at {}", servers.solid->name(), o.solid_endpoint,
             servers.fluid->name(), o.fluid_endpoint);
-  report.data()["servers"] = {
-      {"solid", {{"name", servers.solid->name()}, {"endpoint", o.solid_endpoint}}},
-      {"fluid", {{"name", servers.fluid->name()}, {"endpoint", o.fluid_endpoint}}}};
+  report.data()["servers"] = {{"solid", {{"name", servers.solid->name()}, {"endpoint", o.solid_endpoint}}},
+                              {"fluid", {{"name", servers.fluid->name()}, {"endpoint", o.fluid_endpoint}}}};
 }
 
 void stop_servers(const Servers& servers, const std::string& status, const Logger& log) {
@@ -157,8 +149,7 @@ nlohmann::json earlier_history(const Options& o, const Logger& log) {
         if (old.contains(key)) history[key] = old[key];
     }
   } catch (const std::exception& e) {
-    log->warn("the earlier summary.json does not parse ({}); its history is not carried over",
-              e.what());
+    log->warn("the earlier summary.json does not parse ({}); its history is not carried over", e.what());
   }
   return history;
 }
@@ -170,12 +161,8 @@ void fill_times(fsi::RunReport& report, Clock::time_point start, const Servers& 
   const auto& fluid = servers.fluid;
   auto& w = report.data()["wall_time"];
   w["total"] = std::chrono::duration<double>(Clock::now() - start).count();
-  if (solid)
-    w["solid_compute"] = solid->times().compute,
-    w["solid_messaging"] = solid->times().messaging();
-  if (fluid)
-    w["fluid_compute"] = fluid->times().compute,
-    w["fluid_messaging"] = fluid->times().messaging();
+  if (solid) w["solid_compute"] = solid->times().compute, w["solid_messaging"] = solid->times().messaging();
+  if (fluid) w["fluid_compute"] = fluid->times().compute, w["fluid_messaging"] = fluid->times().messaging();
   if (coupler) w["coupler_mapping_relaxation"] = coupler->times().coupler;
   if (coupler && coupler->times().checkpoint > 0) w["checkpoint"] = coupler->times().checkpoint;
   if (solid && !solid->timings().empty()) w["solid_breakdown"] = solid->timings();
@@ -228,13 +215,12 @@ int write_summary(const Options& o, fsi::RunReport& report, const Servers& serve
     lost = "fluid_server", cause = servers.fluid->client().failure();
   if (outcome.status == "failed" && !lost.empty()) {
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    report.data()["lost_peer"] = {
-        {"process", lost},
-        {"cause", cause == "died"      ? "died"
-                  : cause == "timeout" ? "no answer (timeout)"
-                                       : cause},
-        {"step", outcome.steps + 1},
-        {"wall_seconds", report.data().value("wall_time_earlier_segments", 0.0) + elapsed}};
+    report.data()["lost_peer"] = {{"process", lost},
+                                  {"cause", cause == "died"      ? "died"
+                                            : cause == "timeout" ? "no answer (timeout)"
+                                                                 : cause},
+                                  {"step", outcome.steps + 1},
+                                  {"wall_seconds", report.data().value("wall_time_earlier_segments", 0.0) + elapsed}};
     if (o.recoverable) {
       report.set_status("failed", outcome.reason + " (the launcher will try to recover)");
       report.write();
@@ -287,8 +273,8 @@ int main(int argc, char** argv) {
   if (const int code = write_summary(o, report, servers, outcome, start, log); code >= 0) return code;
   stop_servers(servers, outcome.status, log);
   if (outcome.status == "completed")
-    log->info("completed {} steps, {} coupling iterations; results in {}", outcome.steps,
-              outcome.iterations, o.out_dir);
+    log->info("completed {} steps, {} coupling iterations; results in {}", outcome.steps, outcome.iterations,
+              o.out_dir);
   else
     log->error("{}: {}", outcome.status, outcome.reason);
   return outcome.exit_code();

@@ -1,24 +1,26 @@
 #include "fsi/coupling/settings.hpp"
 
+#include "fsi/common/scene_reader.hpp"
 #include "fsi/coupling/acceleration.hpp"
 #include "fsi/coupling/predictor.hpp"
-#include "fsi/common/scene_reader.hpp"
 
 namespace fsi::coupling {
 
 std::string to_string(Algorithm a) {
-  return a == Algorithm::ExplicitSolidVelocity ? "1 (explicit solid velocity)" : "2 (implicit solid velocity, M_fs damping)";
+  return a == Algorithm::ExplicitSolidVelocity ? "1 (explicit solid velocity)"
+                                               : "2 (implicit solid velocity, M_fs damping)";
 }
 
 std::string to_string(RobinMass m) { return m == RobinMass::Consistent ? "consistent" : "solid"; }
 
 std::string ConvergenceMeasure::name() const {
-  const char* q = quantity == MeasureQuantity::Force      ? "force"
-                  : quantity == MeasureQuantity::Traction ? "traction"
+  const char* q = quantity == MeasureQuantity::Force          ? "force"
+                  : quantity == MeasureQuantity::Traction     ? "traction"
                   : quantity == MeasureQuantity::Displacement ? "displacement"
                                                               : "velocity";
-  const char* t = type == MeasureType::Absolute ? "absolute" : type == MeasureType::Relative ? "relative"
-                                                                                              : "residual_relative";
+  const char* t = type == MeasureType::Absolute   ? "absolute"
+                  : type == MeasureType::Relative ? "relative"
+                                                  : "residual_relative";
   return std::string(q) + "_" + t;
 }
 
@@ -30,8 +32,9 @@ void read_relaxation(const schema::Reader& s, CouplingSettings& c) {
   // (README): Algorithm 1: 2 m_eff / (m_eff + m_a) < 2; Algorithm 2: 2 (m_eff + gamma mu dt) /
   // (m_eff + m_a), which grows with gamma (and can exceed 2).
   if (c.algorithm == Algorithm::ExplicitSolidVelocity && !(c.relaxation < 2.0))
-    s.fail("relaxation", "(beta) must be in (0, 2) with Algorithm 1 (its stability limit 2 m_eff / (m_eff + m_a) "
-                         "is below 2)");
+    s.fail("relaxation",
+           "(beta) must be in (0, 2) with Algorithm 1 (its stability limit 2 m_eff / (m_eff + m_a) "
+           "is below 2)");
 }
 
 // coupling.iqn.imvj: IQN-IMVJ's restart.
@@ -65,8 +68,8 @@ void read_schemes(const schema::Reader& s, CouplingSettings& c) {
   c.acceleration = s.get<std::string>("acceleration");
   c.reuse_steps = accelerator_scheme(c.acceleration).default_reuse_steps;
   if (s.has("iqn") && !accelerator_scheme(c.acceleration).quasi_newton)
-    s.fail("iqn", "is only read with a quasi-Newton acceleration, 'iqn-ils' or 'iqn-imvj' (it is '" + c.acceleration +
-                      "')");
+    s.fail("iqn",
+           "is only read with a quasi-Newton acceleration, 'iqn-ils' or 'iqn-imvj' (it is '" + c.acceleration + "')");
   read_quasi_newton(s.child_or_defaults("iqn"), c);
 }
 
@@ -78,7 +81,7 @@ ConvergenceMeasure read_measure(const schema::Reader& m) {
                 : q == "velocity"     ? MeasureQuantity::Velocity
                                       : MeasureQuantity::Force;
   const auto t = m.get<std::string>("type");
-  cm.type = t == "absolute" ? MeasureType::Absolute
+  cm.type = t == "absolute"            ? MeasureType::Absolute
             : t == "residual-relative" ? MeasureType::ResidualRelative
                                        : MeasureType::Relative;
   cm.limit = m.get<double>("limit");
@@ -126,7 +129,7 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   c.scheme = s.get<std::string>("scheme") == "parallel" ? CouplingScheme::Parallel : CouplingScheme::Serial;
   c.nitsche_penalty = s.get<double>("gamma_n1");
   const auto robin_auto = s.get<std::string>("robin_auto");
-  c.robin_auto = robin_auto == "solid"  ? RobinAuto::Solid
+  c.robin_auto = robin_auto == "solid"   ? RobinAuto::Solid
                  : robin_auto == "fluid" ? RobinAuto::Fluid
                  : robin_auto == "both"  ? RobinAuto::Both
                                          : RobinAuto::None;
@@ -135,8 +138,9 @@ CouplingSettings read_coupling(const ConfigSection& section) {
     s.fail("robin_auto", "on the solid side needs algorithm 2 (Algorithm 1 has no Robin term on the solid)");
   c.fluid_penalty = s.get_or<double>("fluid_penalty", c.nitsche_penalty);
   if (c.fluid_penalty == 0 && c.nitsche_penalty > 0)
-    s.fail("fluid_penalty", "must be > 0 when gamma_n1 > 0 (the fluid imposes the solid's velocity by Nitsche's "
-                            "method with this penalty)");
+    s.fail("fluid_penalty",
+           "must be > 0 when gamma_n1 > 0 (the fluid imposes the solid's velocity by Nitsche's "
+           "method with this penalty)");
   c.nitsche_symmetry = s.get<double>("gamma_n2");
   read_relaxation(s, c);
   read_schemes(s, c);

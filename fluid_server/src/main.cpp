@@ -10,11 +10,13 @@
 #include "fsi/protocol/server_main.hpp"
 
 int main(int argc, char** argv) {
-  return fsi::protocol::server_main(
-      argc, argv,
-      {"fluid",
-       [](const fsi::Scene& scene, const std::string& out) {
-         return fsi::run_standalone_fluid(fsi::models::make_fluid_model, scene, out);
-       },
-       [] { return std::make_unique<fsi::protocol::FluidService>(fsi::models::make_fluid_model, "fsi fluid_server 0.1"); }});
+  return fsi::protocol::server_main(argc, argv,
+                                    {"fluid",
+                                     [](const fsi::Scene& scene, const std::string& out) {
+                                       return fsi::run_standalone_fluid(fsi::models::make_fluid_model, scene, out);
+                                     },
+                                     [] {
+                                       return std::make_unique<fsi::protocol::FluidService>(
+                                           fsi::models::make_fluid_model, "fsi fluid_server 0.1");
+                                     }});
 }

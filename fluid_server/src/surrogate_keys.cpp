@@ -1,7 +1,6 @@
 // The keys of `fluid.model: surrogate`, declared once beside their reader (surrogate_fluid.cpp).
-#include "fsi/models/surrogate_fluid.hpp"
-
 #include "fsi/common/scene_schema.hpp"
+#include "fsi/models/surrogate_fluid.hpp"
 
 namespace fsi::models {
 

@@ -1,14 +1,13 @@
 #include "fsi/protocol/remote.hpp"
 
-#include "fsi/common/utf8.hpp"
-
-#include <algorithm>
-#include <cmath>
-
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+
+#include "fsi/common/utf8.hpp"
 
 namespace fsi::protocol {
 
@@ -44,8 +43,8 @@ NodalMatrix nodal_from_proto(const fsi::v1::NodalMatrix& m, std::size_t n, const
   t.reserve(static_cast<std::size_t>(m.values_size()));
   for (int k = 0; k < m.values_size(); ++k) {
     if (m.rows(k) >= n || m.cols(k) >= n)
-      throw std::invalid_argument(fmt::format("{}: entry {} at ({}, {}) is outside {} x {}", what, k, m.rows(k),
-                                              m.cols(k), n, n));
+      throw std::invalid_argument(
+          fmt::format("{}: entry {} at ({}, {}) is outside {} x {}", what, k, m.rows(k), m.cols(k), n, n));
     if (!std::isfinite(m.values(k)))
       throw std::invalid_argument(fmt::format("{}: entry {} at ({}, {}) is not finite", what, k, m.rows(k), m.cols(k)));
     t.emplace_back(static_cast<int>(m.rows(k)), static_cast<int>(m.cols(k)), m.values(k));
@@ -58,13 +57,12 @@ NodalMatrix nodal_from_proto(const fsi::v1::NodalMatrix& m, std::size_t n, const
 InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
   InterfaceMeshData data;
   const int n = mesh.coordinates_size() / 2;
-  if (mesh.coordinates_size() % 2 != 0)
-    throw std::invalid_argument("interface mesh: odd number of coordinates");
+  if (mesh.coordinates_size() % 2 != 0) throw std::invalid_argument("interface mesh: odd number of coordinates");
   if (n == 0) throw std::invalid_argument("interface mesh: no nodes (coordinates is empty)");
   for (int i = 0; i < mesh.coordinates_size(); ++i)
     if (!std::isfinite(mesh.coordinates(i)))
-      throw std::invalid_argument(fmt::format("interface mesh: coordinate {} of node {} is not finite",
-                                              i % 2 ? "y" : "x", i / 2));
+      throw std::invalid_argument(
+          fmt::format("interface mesh: coordinate {} of node {} is not finite", i % 2 ? "y" : "x", i / 2));
   data.coordinates.resize(n, 2);
   for (int i = 0; i < n; ++i) {
     data.coordinates(i, 0) = mesh.coordinates(2 * i);
@@ -85,7 +83,8 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
   for (int s = 0; s < mesh.segments_size() / 2; ++s) {
     const int a = static_cast<int>(mesh.segments(2 * s)), b = static_cast<int>(mesh.segments(2 * s + 1));
     if (a >= n || b >= n)
-      throw std::invalid_argument(fmt::format("interface mesh: segment {} refers to node {} of {}", s, std::max(a, b), n));
+      throw std::invalid_argument(
+          fmt::format("interface mesh: segment {} refers to node {} of {}", s, std::max(a, b), n));
     if (a == b) throw std::invalid_argument(fmt::format("interface mesh: segment {} joins node {} to itself", s, a));
     data.segments.push_back({a, b});
   }
@@ -97,20 +96,22 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
         fmt::format("interface mesh: {} lumped_measure values for {} nodes", data.lumped_measure.size(), n));
   for (Eigen::Index i = 0; i < data.lumped_measure.size(); ++i)
     if (!(std::isfinite(data.lumped_measure[i]) && data.lumped_measure[i] > 0))
-      throw std::invalid_argument(fmt::format("interface mesh: lumped_measure of node {} is {} (must be finite and "
-                                              "> 0: a negative measure turns Algorithm 2's damping into a source)",
-                                              i, data.lumped_measure[i]));
+      throw std::invalid_argument(
+          fmt::format("interface mesh: lumped_measure of node {} is {} (must be finite and "
+                      "> 0: a negative measure turns Algorithm 2's damping into a source)",
+                      i, data.lumped_measure[i]));
   data.initial_displacement = to_eigen(mesh.initial_displacement());
   data.initial_velocity = to_eigen(mesh.initial_velocity());
   data.mass_per_area = mesh.mass_per_area();
   if (!(std::isfinite(data.mass_per_area) && data.mass_per_area >= 0))
-    throw std::invalid_argument(fmt::format("interface mesh: mass_per_area is {} (must be finite and >= 0)",
-                                            data.mass_per_area));
-  for (const auto& [what, v] : {std::pair<const char*, const Eigen::VectorXd*>{"initial_displacement",
-                                                                               &data.initial_displacement},
-                                {"initial_velocity", &data.initial_velocity}}) {
+    throw std::invalid_argument(
+        fmt::format("interface mesh: mass_per_area is {} (must be finite and >= 0)", data.mass_per_area));
+  for (const auto& [what, v] :
+       {std::pair<const char*, const Eigen::VectorXd*>{"initial_displacement", &data.initial_displacement},
+        {"initial_velocity", &data.initial_velocity}}) {
     if (v->size() != 0 && v->size() != 2 * n)
-      throw std::invalid_argument(fmt::format("interface mesh: {} has {} values, expected 0 or {}", what, v->size(), 2 * n));
+      throw std::invalid_argument(
+          fmt::format("interface mesh: {} has {} values, expected 0 or {}", what, v->size(), 2 * n));
     for (Eigen::Index i = 0; i < v->size(); ++i)
       if (!std::isfinite((*v)[i]))
         throw std::invalid_argument(fmt::format("interface mesh: {} of node {} is not finite", what, i / 2));
@@ -155,11 +156,11 @@ std::string session_name() {
   static const std::string name = [] {
     char host[256] = {0};
     gethostname(host, sizeof host - 1);
-    return fmt::format("{}:{}:{}", host, getpid(),
-                       std::chrono::duration_cast<std::chrono::milliseconds>(
-                           std::chrono::system_clock::now().time_since_epoch())
-                               .count() %
-                           100000000);
+    return fmt::format(
+        "{}:{}:{}", host, getpid(),
+        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+                .count() %
+            100000000);
   }();
   return name;
 }
@@ -173,18 +174,18 @@ std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* su
   if (!reply.has_hello())
     throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " did not answer the handshake with hello");
   if (reply.hello().kind() != expected)
-    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
-                      fmt::format("{} at {} is a {} server, expected a {} server", client.peer_name(),
-                                  client.endpoint(), fsi::v1::ServerKind_Name(reply.hello().kind()),
-                                  fsi::v1::ServerKind_Name(expected)));
+    throw RemoteError(
+        fsi::v1::Error::INVALID_ARGUMENT,
+        fmt::format("{} at {} is a {} server, expected a {} server", client.peer_name(), client.endpoint(),
+                    fsi::v1::ServerKind_Name(reply.hello().kind()), fsi::v1::ServerKind_Name(expected)));
   if (reply.hello().protocol_version() != kProtocolVersion)
-    throw RemoteError(fsi::v1::Error::VERSION_MISMATCH,
-                      fmt::format("{} at {} speaks protocol version {} (HelloReply.protocol_version), this coupler {}",
-                                  client.peer_name(), client.endpoint(), reply.hello().protocol_version(),
-                                  kProtocolVersion));
+    throw RemoteError(
+        fsi::v1::Error::VERSION_MISMATCH,
+        fmt::format("{} at {} speaks protocol version {} (HelloReply.protocol_version), this coupler {}",
+                    client.peer_name(), client.endpoint(), reply.hello().protocol_version(), kProtocolVersion));
   if (reply.hello().server_name().empty())
-    throw RemoteError(fsi::v1::Error::MALFORMED,
-                      fmt::format("{} at {} sent a HelloReply without server_name", client.peer_name(), client.endpoint()));
+    throw RemoteError(fsi::v1::Error::MALFORMED, fmt::format("{} at {} sent a HelloReply without server_name",
+                                                             client.peer_name(), client.endpoint()));
   if (supports_damping) *supports_damping = reply.hello().supports_interface_damping();
   if (supports_interface_mass) *supports_interface_mass = reply.hello().supports_interface_mass();
   *supports_checkpoint = reply.hello().supports_checkpoint();
@@ -204,7 +205,8 @@ fsi::v1::Reply step_call(ProtocolClient& client, const fsi::v1::Request& r) {
 }
 
 void expect(bool ok, const ProtocolClient& client, const char* what) {
-  if (!ok) throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " answered with the wrong reply to " + what);
+  if (!ok)
+    throw RemoteError(fsi::v1::Error::MALFORMED, client.peer_name() + " answered with the wrong reply to " + what);
 }
 
 // GetInterface, checked: a valid mesh with the node count ConfigureReply announced.
@@ -217,7 +219,8 @@ InterfaceMeshData get_interface(ProtocolClient& client, std::uint32_t configured
   try {
     data = interface_from_proto(reply.interface());
   } catch (const std::invalid_argument& e) {
-    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT, fmt::format("{} sent an invalid {}", client.peer_name(), e.what()));
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} sent an invalid {}", client.peer_name(), e.what()));
   }
   if (configured_nodes != 0 && configured_nodes != data.nodes())
     throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
@@ -230,8 +233,8 @@ InterfaceMeshData get_interface(ProtocolClient& client, std::uint32_t configured
 Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, std::size_t n, const ProtocolClient& client,
                         const char* what) {
   if (static_cast<std::size_t>(f.size()) != 2 * n)
-    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
-                      fmt::format("{} sent {} values for '{}', expected {}", client.peer_name(), f.size(), what, 2 * n));
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT, fmt::format("{} sent {} values for '{}', expected {}",
+                                                                    client.peer_name(), f.size(), what, 2 * n));
   Eigen::VectorXd v = to_eigen(f);
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
@@ -255,8 +258,9 @@ std::map<std::string, double> accept_call(ProtocolClient& client, const StepInfo
                                     client.peer_name(), name));
   for (const auto& [name, value] : reply.accept().timings())
     if (!(std::isfinite(value) && value >= 0))
-      throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
-                        fmt::format("{} sent timing '{}' = {} (must be finite and >= 0)", client.peer_name(), name, value));
+      throw RemoteError(
+          fsi::v1::Error::INVALID_ARGUMENT,
+          fmt::format("{} sent timing '{}' = {} (must be finite and >= 0)", client.peer_name(), name, value));
   timings = {reply.accept().timings().begin(), reply.accept().timings().end()};
   return {reply.accept().probes().begin(), reply.accept().probes().end()};
 }
@@ -277,8 +281,9 @@ std::string save_call(ProtocolClient& client, int step, double time) {
   const auto reply = client.call(r);
   expect(reply.has_checkpoint(), client, "save_checkpoint");
   if (reply.checkpoint().state().empty())
-    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
-                      fmt::format("{} answered save_checkpoint of step {} with an empty state", client.peer_name(), step));
+    throw RemoteError(
+        fsi::v1::Error::INVALID_ARGUMENT,
+        fmt::format("{} answered save_checkpoint of step {} with an empty state", client.peer_name(), step));
   return reply.checkpoint().state();
 }
 
@@ -301,8 +306,8 @@ void stop_call(ProtocolClient& client, const std::string& reason) {
 
 // ---------------------------------------------------------------------------- solid
 RemoteSolid::RemoteSolid(std::unique_ptr<ProtocolClient> client) : client_(std::move(client)) {
-  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_, &supports_output_,
-                       &supports_interface_mass_);
+  server_name_ = hello(*client_, fsi::v1::SERVER_KIND_SOLID, &supports_damping_, &supports_checkpoint_,
+                       &supports_output_, &supports_interface_mass_);
 }
 
 std::string RemoteSolid::save_checkpoint(int step, double time) { return save_call(*client_, step, time); }
@@ -331,10 +336,10 @@ SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::Vecto
   send_interface_mass_ = false;
   expect(reply.has_solid_step(), *client_, "solve_step");
   SolidStepResult out;
-  out.interface_displacement = checked(reply.solid_step().interface_displacement(), interface_.nodes(), *client_,
-                                       "interface_displacement");
-  out.interface_velocity = checked(reply.solid_step().interface_velocity(), interface_.nodes(), *client_,
-                                   "interface_velocity");
+  out.interface_displacement =
+      checked(reply.solid_step().interface_displacement(), interface_.nodes(), *client_, "interface_displacement");
+  out.interface_velocity =
+      checked(reply.solid_step().interface_velocity(), interface_.nodes(), *client_, "interface_velocity");
   out.newton_iterations = static_cast<int>(reply.solid_step().newton_iterations());
   return out;
 }

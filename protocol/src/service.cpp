@@ -25,36 +25,34 @@ void set_error(fsi::v1::Reply& reply, fsi::v1::Error::Code code, const std::stri
 }
 
 // Checks a received vector: expected size and every entry finite.
-Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& field,
-                               std::size_t expected, const char* name) {
+Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& field, std::size_t expected,
+                               const char* name) {
   if (static_cast<std::size_t>(field.size()) != expected)
-    throw std::invalid_argument(fmt::format(
-        "'{}' has {} values, expected {} (2 per interface node)", name, field.size(), expected));
+    throw std::invalid_argument(
+        fmt::format("'{}' has {} values, expected {} (2 per interface node)", name, field.size(), expected));
   for (int i = 0; i < field.size(); ++i)
     if (!std::isfinite(field.Get(i)))
-      throw std::invalid_argument(
-          fmt::format("'{}' value {} (node {}, component {}) is not finite: {}", name, i, i / 2,
-                      i % 2 ? "y" : "x", field.Get(i)));
+      throw std::invalid_argument(fmt::format("'{}' value {} (node {}, component {}) is not finite: {}", name, i, i / 2,
+                                              i % 2 ? "y" : "x", field.Get(i)));
   return to_eigen(field);
 }
 
 void require_finite(const Eigen::VectorXd& v, const std::string& what) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
-      throw SolverError(fmt::format("{} produced a non-finite value at node {} ({}): {}", what,
-                                    i / 2, i % 2 ? "y" : "x", v[i]));
+      throw SolverError(
+          fmt::format("{} produced a non-finite value at node {} ({}): {}", what, i / 2, i % 2 ? "y" : "x", v[i]));
 }
 
 Scene scene_from(const fsi::v1::Configure& c) {
   std::vector<std::string> overrides(c.overrides().begin(), c.overrides().end());
-  return Scene::parse(c.scene_text(), c.scene_path().empty() ? "<scene>" : c.scene_path(),
-                      overrides);
+  return Scene::parse(c.scene_text(), c.scene_path().empty() ? "<scene>" : c.scene_path(), overrides);
 }
 
 // The requests a solid and a fluid service answer the same way. Returns false for others.
 template <class Model>
-bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop, Model* model,
-                   double dt, const std::string& not_configured) {
+bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop, Model* model, double dt,
+                   const std::string& not_configured) {
   using R = fsi::v1::Request;
   const auto body = request.body_case();
   if (body == R::kStop) {
@@ -62,15 +60,14 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
     stop = true;
     return true;
   }
-  if (body != R::kGetInterface && body != R::kAcceptStep && body != R::kWriteOutput &&
-      body != R::kSaveCheckpoint && body != R::kLoadCheckpoint)
+  if (body != R::kGetInterface && body != R::kAcceptStep && body != R::kWriteOutput && body != R::kSaveCheckpoint &&
+      body != R::kLoadCheckpoint)
     return false;
   if (!model) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, not_configured);
   if (body == R::kGetInterface) {
     interface_to_proto(model->interface(), reply.mutable_interface());
   } else if (body == R::kAcceptStep) {
-    const StepInfo info{request.accept_step().time(), dt,
-                        static_cast<int>(request.accept_step().step()), 0};
+    const StepInfo info{request.accept_step().time(), dt, static_cast<int>(request.accept_step().step()), 0};
     auto* out = reply.mutable_accept();
     for (const auto& [k, v] : model->accept_step(info)) (*out->mutable_probes())[fsi::valid_utf8(k)] = v;
     for (const auto& [k, v] : model->timings()) (*out->mutable_timings())[k] = v;
@@ -86,16 +83,14 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
       const auto& l = request.load_checkpoint();
       try {
         model->load_state(StateArchive::parse(
-            l.state(),
-            fmt::format("checkpoint of step {} for model '{}'", l.step(), model->name())));
+            l.state(), fmt::format("checkpoint of step {} for model '{}'", l.step(), model->name())));
       } catch (const StateError& e) {
         throw std::invalid_argument(e.what());
       }
       reply.mutable_loaded();
     }
   } else {
-    const StepInfo info{request.write_output().time(), dt,
-                        static_cast<int>(request.write_output().step()), 0};
+    const StepInfo info{request.write_output().time(), dt, static_cast<int>(request.write_output().step()), 0};
     auto* out = reply.mutable_output();
     for (const auto& f : model->write_output(info)) out->add_files(f);
   }
@@ -109,14 +104,12 @@ extern "C" void on_signal(int) { g_signalled = true; }
 
 void Service::peer_gone(const std::string& peer) {
   if (!session_open_ || peer != session_peer_) return;
-  logger("server")->warn("session '{}' of '{}' ended: its connection closed", session_id_,
-                         session_client_);
+  logger("server")->warn("session '{}' of '{}' ended: its connection closed", session_id_, session_client_);
   session_open_ = false;
   reset();
 }
 
-fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop,
-                               const std::string& peer) {
+fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop, const std::string& peer) {
   fsi::v1::Reply reply;
   reply.set_protocol_version(kProtocolVersion);
   reply.set_sequence(request.sequence());
@@ -129,11 +122,9 @@ fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop,
     return reply;
   }
   if (session_open_ && peer != session_peer_) {
-    set_error(
-        reply, fsi::v1::Error::BUSY,
-        fmt::format(
-            "this server is in session '{}' with '{}' (since {}); it serves one coupler at a time",
-            session_id_, session_client_, session_since_));
+    set_error(reply, fsi::v1::Error::BUSY,
+              fmt::format("this server is in session '{}' with '{}' (since {}); it serves one coupler at a time",
+                          session_id_, session_client_, session_since_));
     return reply;
   }
   if (request.body_case() == fsi::v1::Request::BODY_NOT_SET) {
@@ -144,8 +135,7 @@ fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop,
     session_open_ = true;
     session_peer_ = peer;
     session_id_ = request.hello().session().empty() ? "unnamed" : request.hello().session();
-    session_client_ =
-        request.hello().client_name().empty() ? "a client" : request.hello().client_name();
+    session_client_ = request.hello().client_name().empty() ? "a client" : request.hello().client_name();
     const auto now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
     char buf[32];
     std::strftime(buf, sizeof buf, "%H:%M:%S", std::localtime(&now));
@@ -166,15 +156,13 @@ fsi::v1::Reply Service::handle(const fsi::v1::Request& request, bool& stop,
   }
   if (request.body_case() == fsi::v1::Request::kConfigure)
     configure_failure_ = reply.has_error() ? reply.error().message() : std::string();
-  reply.set_compute_seconds(
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  reply.set_compute_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return reply;
 }
 
 std::string Service::before_configure(const std::string& request) const {
   if (configure_failure_.empty()) return fmt::format("'{}' before 'configure'", request);
-  return fmt::format("'{}' on an unconfigured server: the last 'configure' failed ({})", request,
-                     configure_failure_);
+  return fmt::format("'{}' on an unconfigured server: the last 'configure' failed ({})", request, configure_failure_);
 }
 
 std::string Service::handle_bytes(const std::string& bytes, bool& stop, const std::string& peer) {
@@ -195,8 +183,7 @@ SolidService::SolidService(SolidFactory factory, std::string server_name)
 
 void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
   using R = fsi::v1::Request;
-  if (handle_shared(request, reply, stop, model_.get(), dt_, before_configure(body_name(request))))
-    return;
+  if (handle_shared(request, reply, stop, model_.get(), dt_, before_configure(body_name(request)))) return;
   auto need_model = [&](const char* what) {
     if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, before_configure(what));
   };
@@ -219,18 +206,16 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       if (!(c.dt() > 0) || !std::isfinite(c.dt()))
         throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
       if (!std::isfinite(c.interface_damping()) || c.interface_damping() < 0)
-        throw std::invalid_argument(fmt::format(
-            "configure: interface_damping must be finite and >= 0, got {}", c.interface_damping()));
-      if (!std::isfinite(c.end_time()) || c.end_time() < 0)
         throw std::invalid_argument(
-            fmt::format("configure: end_time must be finite and >= 0, got {}", c.end_time()));
+            fmt::format("configure: interface_damping must be finite and >= 0, got {}", c.interface_damping()));
+      if (!std::isfinite(c.end_time()) || c.end_time() < 0)
+        throw std::invalid_argument(fmt::format("configure: end_time must be finite and >= 0, got {}", c.end_time()));
       const Scene scene = scene_from(c);
       const auto section = scene.section(c.section().empty() ? "solid" : c.section());
       auto model = make_model(factory_, section, "solid");
       if (c.interface_damping() > 0 && !model->supports_interface_damping())
         throw RemoteError(fsi::v1::Error::UNSUPPORTED,
-                          fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)",
-                                      model->name()));
+                          fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)", model->name()));
       SolidSetup setup{c.dt(), c.end_time(), c.interface_damping(), c.output_dir(), read_vtk_format(scene)};
       model->configure(section, setup);
       scene.check_all_used(section.path());
@@ -243,10 +228,10 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     case R::kSolveStep: {
       need_model("solve_step");
       const auto& s = request.solve_step();
-      const Eigen::VectorXd force =
-          checked_vector(s.interface_force(), 2 * interface_nodes_, "interface_force");
+      const Eigen::VectorXd force = checked_vector(s.interface_force(), 2 * interface_nodes_, "interface_force");
       StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
-      if (s.has_interface_mass()) model_->set_interface_mass(nodal_from_proto(s.interface_mass(), interface_nodes_, "interface_mass"));
+      if (s.has_interface_mass())
+        model_->set_interface_mass(nodal_from_proto(s.interface_mass(), interface_nodes_, "interface_mass"));
       const SolidStepResult result = model_->solve_step(info, force);
       require_finite(result.interface_displacement, "solid step (displacement)");
       require_finite(result.interface_velocity, "solid step (velocity)");
@@ -268,8 +253,7 @@ FluidService::FluidService(FluidFactory factory, std::string server_name)
 
 void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool& stop) {
   using R = fsi::v1::Request;
-  if (handle_shared(request, reply, stop, model_.get(), 0.0, before_configure(body_name(request))))
-    return;
+  if (handle_shared(request, reply, stop, model_.get(), 0.0, before_configure(body_name(request)))) return;
   auto need_model = [&](const char* what) {
     if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, before_configure(what));
   };
@@ -299,18 +283,17 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       if (!(c.dt() > 0) || !std::isfinite(c.dt()))
         throw std::invalid_argument(fmt::format("configure: dt must be positive, got {}", c.dt()));
       if (!std::isfinite(c.nitsche_penalty()) || c.nitsche_penalty() < 0)
-        throw std::invalid_argument(fmt::format(
-            "configure: nitsche_penalty must be finite and >= 0, got {}", c.nitsche_penalty()));
-      if (!std::isfinite(c.nitsche_symmetry()))
-        throw std::invalid_argument(fmt::format(
-            "configure: nitsche_symmetry must be finite, got {}", c.nitsche_symmetry()));
-      if (!std::isfinite(c.end_time()) || c.end_time() < 0)
         throw std::invalid_argument(
-            fmt::format("configure: end_time must be finite and >= 0, got {}", c.end_time()));
+            fmt::format("configure: nitsche_penalty must be finite and >= 0, got {}", c.nitsche_penalty()));
+      if (!std::isfinite(c.nitsche_symmetry()))
+        throw std::invalid_argument(
+            fmt::format("configure: nitsche_symmetry must be finite, got {}", c.nitsche_symmetry()));
+      if (!std::isfinite(c.end_time()) || c.end_time() < 0)
+        throw std::invalid_argument(fmt::format("configure: end_time must be finite and >= 0, got {}", c.end_time()));
       const Scene scene = scene_from(c);
       const auto section = scene.section(c.section().empty() ? "fluid" : c.section());
       auto model = make_model(factory_, section, "fluid");
-      FluidSetup setup{c.dt(), c.end_time(), c.nitsche_penalty(), c.nitsche_symmetry(),
+      FluidSetup setup{c.dt(),         c.end_time(),          c.nitsche_penalty(), c.nitsche_symmetry(),
                        c.output_dir(), read_vtk_format(scene)};
       model->configure(section, setup);
       scene.check_all_used(section.path());
@@ -323,8 +306,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       need_model("initial_loads");
       const auto& s = request.initial_loads();
       loads_reply(model_->initial_loads(
-          checked_vector(s.interface_displacement(), 2 * interface_nodes_,
-                         "interface_displacement"),
+          checked_vector(s.interface_displacement(), 2 * interface_nodes_, "interface_displacement"),
           checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
       break;
     }
@@ -333,9 +315,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       const auto& s = request.solve_step();
       StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
       loads_reply(model_->solve_step(
-          info,
-          checked_vector(s.interface_displacement(), 2 * interface_nodes_,
-                         "interface_displacement"),
+          info, checked_vector(s.interface_displacement(), 2 * interface_nodes_, "interface_displacement"),
           checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
       break;
     }
@@ -346,23 +326,20 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
 }
 
 // ---------------------------------------------------------------------------- server loop
-int run_server(Service& service, const std::string& endpoint, const std::string& port_file,
-               double idle_timeout_seconds, const std::string& log_name,
-               const transport::CurveKeys& keys) {
+int run_server(Service& service, const std::string& endpoint, const std::string& port_file, double idle_timeout_seconds,
+               const std::string& log_name, const transport::CurveKeys& keys) {
   auto log = logger(log_name);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   if (!keys.enabled() && endpoint.find("127.0.0.1") == std::string::npos &&
-      endpoint.find("localhost") == std::string::npos &&
-      endpoint.find("[::1]") == std::string::npos)
+      endpoint.find("localhost") == std::string::npos && endpoint.find("[::1]") == std::string::npos)
     log->warn(
         "{} accepts any client that can reach it: use --curve-keys DIR (fsi keys DIR) beyond "
         "loopback",
         endpoint);
   transport::Server server(endpoint, keys);
   if (keys.enabled())
-    log->info("CURVE: encrypted, {} authorised client key(s) from {}", keys.authorized.size(),
-              keys.folder);
+    log->info("CURVE: encrypted, {} authorised client key(s) from {}", keys.authorized.size(), keys.folder);
   const std::string bound = server.endpoint();
   if (!port_file.empty()) {
     const std::string tmp = port_file + ".tmp";
@@ -374,11 +351,10 @@ int run_server(Service& service, const std::string& endpoint, const std::string&
   server.set_frame_error_handler([](std::size_t frames) {
     fsi::v1::Reply reply;
     reply.set_protocol_version(kProtocolVersion);
-    set_error(
-        reply, fsi::v1::Error::MALFORMED,
-        fmt::format("message has {} frames after the envelope, expected exactly 1 (one serialised "
-                    "fsi.v1.Request)",
-                    frames));
+    set_error(reply, fsi::v1::Error::MALFORMED,
+              fmt::format("message has {} frames after the envelope, expected exactly 1 (one serialised "
+                          "fsi.v1.Request)",
+                          frames));
     return reply.SerializeAsString();
   });
   const auto idle = std::chrono::milliseconds(static_cast<long>(idle_timeout_seconds * 1000));

@@ -10,11 +10,13 @@
 #include "fsi/protocol/server_main.hpp"
 
 int main(int argc, char** argv) {
-  return fsi::protocol::server_main(
-      argc, argv,
-      {"solid",
-       [](const fsi::Scene& scene, const std::string& out) {
-         return fsi::run_standalone_solid(fsi::models::make_solid_model, scene, out);
-       },
-       [] { return std::make_unique<fsi::protocol::SolidService>(fsi::models::make_solid_model, "fsi solid_server 0.1"); }});
+  return fsi::protocol::server_main(argc, argv,
+                                    {"solid",
+                                     [](const fsi::Scene& scene, const std::string& out) {
+                                       return fsi::run_standalone_solid(fsi::models::make_solid_model, scene, out);
+                                     },
+                                     [] {
+                                       return std::make_unique<fsi::protocol::SolidService>(
+                                           fsi::models::make_solid_model, "fsi solid_server 0.1");
+                                     }});
 }

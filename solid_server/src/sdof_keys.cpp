@@ -1,7 +1,6 @@
 // The keys of `solid.model: sdof`, declared once beside their reader (sdof_solid.cpp).
-#include "fsi/models/sdof_solid.hpp"
-
 #include "fsi/common/scene_schema.hpp"
+#include "fsi/models/sdof_solid.hpp"
 
 namespace fsi::models {
 

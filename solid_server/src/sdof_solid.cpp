@@ -10,7 +10,6 @@ Eigen::Vector2d vector2(const schema::Reader& r, const std::string& key) {
 }
 }  // namespace
 
-
 void SdofSolid::configure(const ConfigSection& section, const SolidSetup& setup) {
   const schema::Reader s(section, sdof_solid_keys());
   mass_ = s.get<double>("mass");
@@ -49,7 +48,8 @@ SolidStepResult SdofSolid::solve_step(const StepInfo& info, const Eigen::VectorX
   const double c = damping_ + interface_damping_;
   // m (d - d_n - dt v_n)/dt^2 + c (d - d_n)/dt + k d = F
   const double lhs = mass_ / (dt * dt) + c / dt + stiffness_;
-  const Eigen::Vector2d rhs = interface_force.head<2>() + force_ + mass_ * (d_n_ / (dt * dt) + v_n_ / dt) + c * d_n_ / dt;
+  const Eigen::Vector2d rhs =
+      interface_force.head<2>() + force_ + mass_ * (d_n_ / (dt * dt) + v_n_ / dt) + c * d_n_ / dt;
   d_ = rhs / lhs;
   v_ = (d_ - d_n_) / dt;
   return {d_, v_, 1};

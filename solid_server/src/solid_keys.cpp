@@ -13,8 +13,8 @@ const schema::Key& solid_section() {
     std::vector<schema::KeyVariant> models{
         {"sdof", "single-degree-of-freedom point solid m a + c v + k d = F", sdof_solid_keys()}};
 #ifdef FSI_HAVE_FEM_SOLID
-    models.push_back({"fem", "finite-strain Q4 solid (Saint Venant-Kirchhoff or neo-Hookean)",
-                      fsi::solid::fem_solid_keys()});
+    models.push_back(
+        {"fem", "finite-strain Q4 solid (Saint Venant-Kirchhoff or neo-Hookean)", fsi::solid::fem_solid_keys()});
 #endif
     schema::Key k = schema::selector_section("solid", "the solid solver (solid_server)", "model", std::move(models));
     schema::declare(k);

@@ -101,7 +101,8 @@ TEST(NavierStokesFluid, MovesItsMeshWithTheInterfaceDisplacement) {
   const std::string text = std::string(R"(
 fluid:
   model: fem
-  mesh: {geo: )") + FSI_FLUID_SOURCE_DIR + R"(/configs/meshes/dfg_cylinder.geo, size: 0.08, parameters: {hc: 0.01}}
+  mesh: {geo: )") + FSI_FLUID_SOURCE_DIR +
+                           R"(/configs/meshes/dfg_cylinder.geo, size: 0.08, parameters: {hc: 0.01}}
   density: 1.0
   viscosity: 0.001
   scheme: bdf2

@@ -35,14 +35,18 @@ std::string scene_text(const Case& c) {
   return std::string(R"(
 fluid:
   model: fem
-  element: )") + c.element + R"(
-  mesh: {geo: )" + FSI_FLUID_SOURCE_DIR + "/configs/meshes/dfg_cylinder.geo, size: " + std::to_string(c.size) +
+  element: )") +
+         c.element + R"(
+  mesh: {geo: )" +
+         FSI_FLUID_SOURCE_DIR + "/configs/meshes/dfg_cylinder.geo, size: " + std::to_string(c.size) +
          R"(, parameters: {hc: 0.02}}
   density: 1.0
   viscosity: 0.001
   scheme: bdf2
-  nonlinear: {max_iterations: 1, relinearise: )" + (c.relinearise ? "true" : "false") + R"(}
-  linear_solver: {reuse_factorisation: )" + (c.reuse ? "true" : "false") + R"(}
+  nonlinear: {max_iterations: 1, relinearise: )" +
+         (c.relinearise ? "true" : "false") + R"(}
+  linear_solver: {reuse_factorisation: )" +
+         (c.reuse ? "true" : "false") + R"(}
   inflow: [{group: inlet, max_velocity: 1.5, ramp_time: 0.05}]
   walls: [walls]
   outlet: [outlet]
@@ -127,8 +131,8 @@ void expect_identical(const StepRecord& a, const StepRecord& b, int step) {
   ASSERT_EQ(a.probes.size(), b.probes.size()) << at;
   for (const auto& [name, value] : a.probes) {
     ASSERT_EQ(b.probes.count(name), 1u) << at << " probe " << name;
-    EXPECT_EQ(bits(value), bits(b.probes.at(name))) << at << " probe " << name << ": " << value << " vs "
-                                                    << b.probes.at(name);
+    EXPECT_EQ(bits(value), bits(b.probes.at(name)))
+        << at << " probe " << name << ": " << value << " vs " << b.probes.at(name);
   }
 }
 
@@ -173,18 +177,21 @@ TEST_P(FluidCheckpoint, RestoredModelContinuesBitForBit) {
   }
   // The flow did move (the comparison is not between two zero states).
   EXPECT_GT(std::abs(expected.back().probes.at("cyl_drag")), 1e-4);
-  const double factorisations_after = expected.back().probes.at("factorisations") - state.integer("fluid.factorisations");
-  if (c.reuse) EXPECT_LT(factorisations_after, 2 * (n - k)) << "BiCGSTAB on old factors was not exercised";
-  else EXPECT_EQ(factorisations_after, 2 * (n - k));
+  const double factorisations_after =
+      expected.back().probes.at("factorisations") - state.integer("fluid.factorisations");
+  if (c.reuse)
+    EXPECT_LT(factorisations_after, 2 * (n - k)) << "BiCGSTAB on old factors was not exercised";
+  else
+    EXPECT_EQ(factorisations_after, 2 * (n - k));
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    ElementsReuseAndMeshMotion, FluidCheckpoint,
-    ::testing::Combine(::testing::Values(std::string("p1p1"), std::string("p2p1")), ::testing::Bool(), ::testing::Bool()),
-    [](const auto& info) {
-      return std::get<0>(info.param) + (std::get<1>(info.param) ? "_reuse" : "_direct") +
-             (std::get<2>(info.param) ? "_incremental_relinearised" : "_fixed_operator");
-    });
+INSTANTIATE_TEST_SUITE_P(ElementsReuseAndMeshMotion, FluidCheckpoint,
+                         ::testing::Combine(::testing::Values(std::string("p1p1"), std::string("p2p1")),
+                                            ::testing::Bool(), ::testing::Bool()),
+                         [](const auto& info) {
+                           return std::get<0>(info.param) + (std::get<1>(info.param) ? "_reuse" : "_direct") +
+                                  (std::get<2>(info.param) ? "_incremental_relinearised" : "_fixed_operator");
+                         });
 
 TEST(FluidCheckpoint, TwoUninterruptedRunsAreIdentical) {
   // No wall-clock timing decides the ordering or when to refactorise.
@@ -231,7 +238,8 @@ TEST(FluidCheckpoint, StateOfAnotherMeshIsRefusedNamingTheEntry) {
 }
 
 TEST(SurrogateFluidCheckpoint, RestoredModelContinuesBitForBit) {
-  const std::string text = "fluid: {model: surrogate, force: [1.282, -0.25], added_mass: 0.37, interface_measure: 2.5}\n";
+  const std::string text =
+      "fluid: {model: surrogate, force: [1.282, -0.25], added_mass: 0.37, interface_measure: 2.5}\n";
   auto make = [&](fsi::Scene& scene, fsi::models::SurrogateFluid& m) {
     fsi::FluidSetup setup;
     setup.dt = 0.1;
@@ -253,7 +261,8 @@ TEST(SurrogateFluidCheckpoint, RestoredModelContinuesBitForBit) {
   const int k = 3, n = 7;
   for (int step = 1; step <= n; ++step) {
     fsi::FluidLoads loads;
-    for (int it = 1; it <= 2; ++it) loads = a.solve_step(fsi::StepInfo{0.1 * step, 0.1, step, it}, Eigen::VectorXd::Zero(2), input(step, it));
+    for (int it = 1; it <= 2; ++it)
+      loads = a.solve_step(fsi::StepInfo{0.1 * step, 0.1, step, it}, Eigen::VectorXd::Zero(2), input(step, it));
     const auto probes = a.accept_step(fsi::StepInfo{0.1 * step, 0.1, step, 2});
     if (step == k) {
       fsi::StateArchive s;
@@ -268,7 +277,8 @@ TEST(SurrogateFluidCheckpoint, RestoredModelContinuesBitForBit) {
   b.load_state(fsi::StateArchive::parse(bytes, "surrogate checkpoint"));
   for (int step = k + 1; step <= n; ++step) {
     fsi::FluidLoads loads;
-    for (int it = 1; it <= 2; ++it) loads = b.solve_step(fsi::StepInfo{0.1 * step, 0.1, step, it}, Eigen::VectorXd::Zero(2), input(step, it));
+    for (int it = 1; it <= 2; ++it)
+      loads = b.solve_step(fsi::StepInfo{0.1 * step, 0.1, step, it}, Eigen::VectorXd::Zero(2), input(step, it));
     const auto probes = b.accept_step(fsi::StepInfo{0.1 * step, 0.1, step, 2});
     const auto& [eloads, eprobes] = expected[static_cast<std::size_t>(step - k - 1)];
     expect_identical(eloads.traction_force, loads.traction_force, "traction");

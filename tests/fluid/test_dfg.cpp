@@ -26,16 +26,18 @@ TEST(DfgBenchmark, Dfg2d1WithinTolerances) {
   model.solve_step(info, {}, {});
   const auto probes = model.accept_step(info);
   const double cd = probes.at("cd"), cl = probes.at("cl"), dp = probes.at("dp");
-  std::printf("DFG 2D-1: C_D %.5f (ref 5.57954, %.3f%%)  C_L %.6f (ref 0.0106189, %.2f%%)  dp %.5f (ref 0.117520, %.3f%%)\n",
-              cd, 100 * (cd / 5.57953523384 - 1), cl, 100 * (cl / 0.010618948146 - 1), dp, 100 * (dp / 0.11752016697 - 1));
+  std::printf(
+      "DFG 2D-1: C_D %.5f (ref 5.57954, %.3f%%)  C_L %.6f (ref 0.0106189, %.2f%%)  dp %.5f (ref 0.117520, %.3f%%)\n",
+      cd, 100 * (cd / 5.57953523384 - 1), cl, 100 * (cl / 0.010618948146 - 1), dp, 100 * (dp / 0.11752016697 - 1));
   EXPECT_NEAR(cd, 5.57953523384, 0.01 * 5.57953523384);
   EXPECT_NEAR(cl, 0.010618948146, 0.05 * 0.010618948146);
   EXPECT_NEAR(dp, 0.11752016697, 0.01 * 0.11752016697);
 }
 
 TEST(DfgBenchmark, Dfg2d1TaylorHoodNewtonWithinTheTightTolerances) {
-  auto scene = fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1_p2p1.yaml",
-                                {"fluid.mesh.cache_dir=" + (std::filesystem::temp_directory_path() / "fsi_fluid_test_meshes").string()});
+  auto scene = fsi::Scene::load(
+      FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1_p2p1.yaml",
+      {"fluid.mesh.cache_dir=" + (std::filesystem::temp_directory_path() / "fsi_fluid_test_meshes").string()});
   const auto fluid = scene.section("fluid");
   ASSERT_EQ(fluid.get<std::string>("model"), "fem");
   fsi::FluidSetup setup;
@@ -49,9 +51,10 @@ TEST(DfgBenchmark, Dfg2d1TaylorHoodNewtonWithinTheTightTolerances) {
   model.solve_step(info, {}, {});
   const auto probes = model.accept_step(info);
   const double cd = probes.at("cd"), cl = probes.at("cl"), dp = probes.at("dp");
-  std::printf("DFG 2D-1 P2/P1 (%d unknowns, %g Newton solves): C_D %.6f (%.4f%%)  C_L %.7f (%.3f%%)  dp %.6f (%.4f%%)\n",
-              model.solver().dofs(), probes.at("nonlinear_iterations"), cd, 100 * (cd / 5.57953523384 - 1), cl,
-              100 * (cl / 0.010618948146 - 1), dp, 100 * (dp / 0.11752016697 - 1));
+  std::printf(
+      "DFG 2D-1 P2/P1 (%d unknowns, %g Newton solves): C_D %.6f (%.4f%%)  C_L %.7f (%.3f%%)  dp %.6f (%.4f%%)\n",
+      model.solver().dofs(), probes.at("nonlinear_iterations"), cd, 100 * (cd / 5.57953523384 - 1), cl,
+      100 * (cl / 0.010618948146 - 1), dp, 100 * (dp / 0.11752016697 - 1));
   EXPECT_NEAR(cd, 5.57953523384, 1e-4 * 5.57953523384);
   EXPECT_NEAR(cl, 0.010618948146, 5e-3 * 0.010618948146);
   EXPECT_NEAR(dp, 0.11752016697, 1e-3 * 0.11752016697);
@@ -67,8 +70,8 @@ TEST(DfgBenchmark, P1OnlyKeysAreRejectedForTaylorHood) {
 }
 
 TEST(DfgBenchmark, UnknownSceneKeyIsRejected) {
-  auto scene = fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1.yaml",
-                                {"fluid.mesh.size=0.08", "fluid.scheme=bdf3"});
+  auto scene =
+      fsi::Scene::load(FSI_FLUID_SOURCE_DIR "/configs/dfg_2d1.yaml", {"fluid.mesh.size=0.08", "fluid.scheme=bdf3"});
   fsi::fluid::NavierStokesFluid model;
   EXPECT_THROW(model.configure(scene.section("fluid"), fsi::FluidSetup{}), fsi::ConfigError);
 }

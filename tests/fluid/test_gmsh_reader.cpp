@@ -68,7 +68,8 @@ TEST(GmshReader, ReadsGmshGeneratedMeshInBothFormats) {
                             out.string() + "' > /dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     const auto mesh = fsi::read_gmsh(out);
-    for (const char* name : {"inlet", "outlet", "walls", "cylinder", "fluid"}) EXPECT_TRUE(mesh.has_group(name)) << name;
+    for (const char* name : {"inlet", "outlet", "walls", "cylinder", "fluid"})
+      EXPECT_TRUE(mesh.has_group(name)) << name;
     EXPECT_GT(mesh.group("fluid").elements.rows(), 100);
     // Cylinder nodes lie on the circle.
     const auto& cyl = mesh.group("cylinder");

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 
 #include "fsi/fluid/mesh_motion.hpp"
@@ -36,7 +35,8 @@ double min_area(const FluidMesh& mesh, const Eigen::MatrixX2d& displacement) {
   double smallest = 1e300;
   for (int e = 0; e < mesh.triangle_count(); ++e) {
     Eigen::Matrix<double, 3, 2> x;
-    for (int k = 0; k < 3; ++k) x.row(k) = mesh.nodes.row(mesh.triangles(e, k)) + displacement.row(mesh.triangles(e, k));
+    for (int k = 0; k < 3; ++k)
+      x.row(k) = mesh.nodes.row(mesh.triangles(e, k)) + displacement.row(mesh.triangles(e, k));
     smallest = std::min(smallest, triangle_geometry(x).area);
   }
   return smallest;

@@ -8,8 +8,8 @@
 
 namespace {
 
-using fsi::fluid::FluidMesh;
 using fsi::fluid::FlowParameters;
+using fsi::fluid::FluidMesh;
 using fsi::fluid::NavierStokesSolver;
 using fsi::fluid::TimeScheme;
 
@@ -41,7 +41,7 @@ TEST(P1Element, RowsAnnihilateConstantsAndLinearFieldsAreConsistent) {
   constant_velocity << 1, 2, 0, 1, 2, 0, 1, 2, 0;
   const Eigen::Matrix<double, 9, 1> r = out.matrix * constant_velocity;
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(r(3 * i), 0.0, 1e-12);      // no viscous or LSIC force
+    EXPECT_NEAR(r(3 * i), 0.0, 1e-12);  // no viscous or LSIC force
     EXPECT_NEAR(r(3 * i + 1), 0.0, 1e-12);
     EXPECT_NEAR(r(3 * i + 2), 0.0, 1e-12);  // divergence-free, no PSPG residual
   }
@@ -78,7 +78,8 @@ TEST(NavierStokesSolver, PoiseuilleFlowIsReproduced) {
   EXPECT_LT(report.change, 1e-8);
   const auto v = solver.velocity();
   double err = 0;
-  for (int i = 0; i < mesh.node_count(); ++i) err = std::max(err, (v.row(i).transpose() - profile(mesh.nodes.row(i), 0)).norm());
+  for (int i = 0; i < mesh.node_count(); ++i)
+    err = std::max(err, (v.row(i).transpose() - profile(mesh.nodes.row(i), 0)).norm());
   EXPECT_LT(err, 1e-2);  // P1 interpolation of the parabola: h^2/8 |u''| = 4e-3
   // dp/dx = -8 mu (u_max 1, half-height 0.5): p(0.5) - p(1.5) = 0.8
   const double dp = solver.pressure_at({0.5, 0.5}) - solver.pressure_at({1.5, 0.5});
@@ -123,7 +124,8 @@ std::pair<double, double> kovasznay_errors(int nx, bool viscous_residual = false
   EXPECT_LT(report.change, 1e-9) << "Picard did not converge on " << nx;
   // The discrete pressure is fixed at one node; compare after removing the mean difference.
   const auto& U = solver.solution();
-  static const double kN[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
+  static const double kN[3][3] = {
+      {2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
   double ev = 0, ep = 0, mean_diff = 0, area_sum = 0;
   for (int pass = 0; pass < 2; ++pass)
     for (int e = 0; e < mesh.triangle_count(); ++e) {
@@ -177,9 +179,10 @@ TEST(NavierStokesSolver, KovasznayWithReconstructedViscousResidual) {
   }
   const double rate_v = std::log(ev[1] / ev[2]) / std::log(2.0);
   const double rate_p = std::log(ep[1] / ep[2]) / std::log(2.0);
-  std::printf("Kovasznay Re 40, viscous residual: velocity L2 errors %.3e %.3e %.3e (rate %.2f); pressure %.3e %.3e "
-              "%.3e (rate %.2f); pressure error ratio to the plain residual %.3f %.3f %.3f\n",
-              ev[0], ev[1], ev[2], rate_v, ep[0], ep[1], ep[2], rate_p, ep[0] / ep0[0], ep[1] / ep0[1], ep[2] / ep0[2]);
+  std::printf(
+      "Kovasznay Re 40, viscous residual: velocity L2 errors %.3e %.3e %.3e (rate %.2f); pressure %.3e %.3e "
+      "%.3e (rate %.2f); pressure error ratio to the plain residual %.3f %.3f %.3f\n",
+      ev[0], ev[1], ev[2], rate_v, ep[0], ep[1], ep[2], rate_p, ep[0] / ep0[0], ep[1] / ep0[1], ep[2] / ep0[2]);
   EXPECT_GT(rate_v, 1.8);
   EXPECT_GT(rate_p, 1.2);
   for (int k = 0; k < 3; ++k) EXPECT_LT(ep[k], ep0[k]) << "mesh " << sizes[k];

@@ -39,8 +39,10 @@ NavierStokesSolver make_solver(const FluidMesh& mesh, bool nitsche, double penal
     return Eigen::Vector2d(4 * 0.3 * x.y() * (0.41 - x.y()) / (0.41 * 0.41), 0);
   });
   s.add_dirichlet("walls", [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
-  if (nitsche) s.set_interface({"cylinder"});
-  else s.add_dirichlet("cylinder", [](const Eigen::Vector2d& x, double) { return rotation(x); });
+  if (nitsche)
+    s.set_interface({"cylinder"});
+  else
+    s.add_dirichlet("cylinder", [](const Eigen::Vector2d& x, double) { return rotation(x); });
   return s;
 }
 
@@ -69,7 +71,8 @@ TEST(Nitsche, RotatingCylinderForcesMatchStrongDirichlet) {
       const Eigen::Vector2d f = weak.force({"cylinder"});
       std::printf("gamma_N2 %+g gamma_N1 %5.1f: C_D %.5f  C_L %.5f\n", symmetry, penalty, scale * f.x(), scale * f.y());
       EXPECT_NEAR(f.x(), f_strong.x(), 0.01 * f_strong.x()) << "gamma_N2 " << symmetry << " gamma_N1 " << penalty;
-      EXPECT_NEAR(f.y(), f_strong.y(), 0.03 * std::abs(f_strong.y())) << "gamma_N2 " << symmetry << " gamma_N1 " << penalty;
+      EXPECT_NEAR(f.y(), f_strong.y(), 0.03 * std::abs(f_strong.y()))
+          << "gamma_N2 " << symmetry << " gamma_N1 " << penalty;
 
       // Contract: f_v = int N^T v_f ~ M_G v_s (the slip is small), and the coupler's
       // F* = f_sigma - gamma_N1 (f_v - M_G v_s) is exactly the consistent reaction, whose sum
@@ -81,7 +84,8 @@ TEST(Nitsche, RotatingCylinderForcesMatchStrongDirichlet) {
       Eigen::VectorXd mv = Eigen::VectorXd::Zero(fv.size());
       for (Eigen::Index s = 0; s < seg.rows(); ++s) {
         const int a = seg(s, 0), b = seg(s, 1);
-        const double len = (mesh.nodes.row(weak.interface_nodes()[a]) - mesh.nodes.row(weak.interface_nodes()[b])).norm();
+        const double len =
+            (mesh.nodes.row(weak.interface_nodes()[a]) - mesh.nodes.row(weak.interface_nodes()[b])).norm();
         mv.segment<2>(2 * a) += len / 6 * (2 * vs.segment<2>(2 * a) + vs.segment<2>(2 * b));
         mv.segment<2>(2 * b) += len / 6 * (vs.segment<2>(2 * a) + 2 * vs.segment<2>(2 * b));
       }
@@ -160,6 +164,6 @@ double interface_mass_after_dilation(bool step_start) {
 TEST(Nitsche, InterfaceMassIsThePenaltyOperatorInItsConfiguration) {
   const double current = interface_mass_after_dilation(false);
   const double start = interface_mass_after_dilation(true);
-  EXPECT_NEAR(current / start, 1.01, 1e-12);              // the polygon's perimeter scales exactly
+  EXPECT_NEAR(current / start, 1.01, 1e-12);                     // the polygon's perimeter scales exactly
   EXPECT_NEAR(start, 2 * M_PI * 0.05, 0.002 * 2 * M_PI * 0.05);  // the undeformed circle (polygon)
 }

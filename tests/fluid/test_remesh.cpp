@@ -4,14 +4,13 @@
 // remesh (the mesh is in the state) or before it (the restored model remeshes itself); a run
 // that never remeshes is bit for bit the run without the remesh settings.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <tuple>
@@ -41,14 +40,18 @@ std::string scene_text(const Case& c) {
   return std::string(R"(
 fluid:
   model: fem
-  element: )") + c.element + R"(
-  mesh: {geo: )" + FSI_FLUID_SOURCE_DIR + "/configs/meshes/dfg_cylinder.geo, size: " + std::to_string(c.size) +
+  element: )") +
+         c.element + R"(
+  mesh: {geo: )" +
+         FSI_FLUID_SOURCE_DIR + "/configs/meshes/dfg_cylinder.geo, size: " + std::to_string(c.size) +
          R"(, parameters: {hc: 0.02}}
   density: 1.0
   viscosity: 0.001
   scheme: bdf2
-  nonlinear: {max_iterations: 1, relinearise: )" + (c.relinearise ? "true" : "false") + R"(}
-  linear_solver: {reuse_factorisation: )" + (c.reuse ? "true" : "false") + R"(}
+  nonlinear: {max_iterations: 1, relinearise: )" +
+         (c.relinearise ? "true" : "false") + R"(}
+  linear_solver: {reuse_factorisation: )" +
+         (c.reuse ? "true" : "false") + R"(}
   inflow: [{group: inlet, max_velocity: 1.5, ramp_time: 0.05}]
   walls: [walls]
   outlet: [outlet]
@@ -57,7 +60,8 @@ fluid:
   forces: [{name: cyl, groups: [cylinder], reference_velocity: 1.0, reference_length: 0.1}]
   pressure_probes: {p_front: [0.15, 0.2], p_back: [0.25, 0.2]}
   pressure_differences: {dp: [p_front, p_back]}
-)" + (c.remesh.empty() ? std::string() : "  remesh: " + c.remesh + "\n") + c.extra;
+)" + (c.remesh.empty() ? std::string() : "  remesh: " + c.remesh + "\n") +
+         c.extra;
 }
 
 constexpr double kDt = 0.01;
@@ -133,8 +137,8 @@ void expect_identical(const StepRecord& a, const StepRecord& b, int step) {
   ASSERT_EQ(a.probes.size(), b.probes.size()) << at;
   for (const auto& [name, value] : a.probes) {
     ASSERT_EQ(b.probes.count(name), 1u) << at << " probe " << name;
-    EXPECT_EQ(bits(value), bits(b.probes.at(name))) << at << " probe " << name << ": " << value << " vs "
-                                                    << b.probes.at(name);
+    EXPECT_EQ(bits(value), bits(b.probes.at(name)))
+        << at << " probe " << name << ": " << value << " vs " << b.probes.at(name);
   }
 }
 
@@ -170,7 +174,8 @@ TEST_P(FluidRemesh, KeepsBoundaryNodesAndSizes) {
   }
   const auto iface_old = old.mesh().boundary_nodes({"cylinder"}), iface_new = m.boundary_nodes({"cylinder"});
   ASSERT_EQ(iface_old.size(), iface_new.size());
-  for (std::size_t k = 0; k < iface_new.size(); ++k) EXPECT_EQ(r.old_node[static_cast<std::size_t>(iface_new[k])], iface_old[k]);
+  for (std::size_t k = 0; k < iface_new.size(); ++k)
+    EXPECT_EQ(r.old_node[static_cast<std::size_t>(iface_new[k])], iface_old[k]);
   // Sizes as before (within 20 % in the number of triangles), a good mesh, the same area.
   const double ratio = static_cast<double>(m.triangle_count()) / old.mesh().triangle_count();
   EXPECT_GT(ratio, 0.8);
@@ -204,7 +209,9 @@ TEST_P(FluidRemesh, ForcedRemeshChangesTheForcesByLittle) {
     rb = run_step(b.model, b.nodes, step);
     if (step <= 6) expect_identical(ra, rb, step);  // the remesh follows step 6's probes
     if (HasFatalFailure()) return;
-    if (step > 6) worst = std::max(worst, std::abs(rb.probes.at("cyl_cd") - ra.probes.at("cyl_cd")) / std::abs(ra.probes.at("cyl_cd")));
+    if (step > 6)
+      worst =
+          std::max(worst, std::abs(rb.probes.at("cyl_cd") - ra.probes.at("cyl_cd")) / std::abs(ra.probes.at("cyl_cd")));
   }
   EXPECT_EQ(b.model.timings().at("remeshes"), 1);
   EXPECT_EQ(a.model.timings().count("remeshes"), 0u);
@@ -215,7 +222,8 @@ TEST_P(FluidRemesh, ForcedRemeshChangesTheForcesByLittle) {
   // interpolated velocity is not discretely divergence-free) and 0.083 (p2p1); 6 steps
   // after it 5.2 % and 0.71 %.
   EXPECT_LT(worst, GetParam() == "p1p1" ? 0.6 : 0.15) << "worst relative C_D change after the remesh " << worst;
-  EXPECT_NEAR(rb.probes.at("cyl_cd"), ra.probes.at("cyl_cd"), (GetParam() == "p1p1" ? 0.1 : 0.015) * ra.probes.at("cyl_cd"));
+  EXPECT_NEAR(rb.probes.at("cyl_cd"), ra.probes.at("cyl_cd"),
+              (GetParam() == "p1p1" ? 0.1 : 0.015) * ra.probes.at("cyl_cd"));
   std::printf("%s: worst relative C_D change after the remesh %.3e, at step %d %.6f vs %.6f\n", GetParam().c_str(),
               worst, n, rb.probes.at("cyl_cd"), ra.probes.at("cyl_cd"));
 }
@@ -296,7 +304,8 @@ TEST(FluidInitialState, AnotherMeshAndElementStartFromACheckpoint) {
   for (int step = 1; step <= 10; ++step) last = run_step(a.model, a.nodes, step).probes;
   fsi::StateArchive state;
   a.model.save_state(state);
-  const auto file = std::filesystem::temp_directory_path() / ("fsi_initial_state_" + std::to_string(::getpid()) + ".state");
+  const auto file =
+      std::filesystem::temp_directory_path() / ("fsi_initial_state_" + std::to_string(::getpid()) + ".state");
   std::ofstream(file, std::ios::binary) << state.serialize();
   Case fine;
   fine.element = "p2p1";
@@ -305,8 +314,8 @@ TEST(FluidInitialState, AnotherMeshAndElementStartFromACheckpoint) {
   Model b(fine);
   std::filesystem::remove(file);
   double worst = 0, scale = 0;
-  for (const Eigen::Vector2d p : {Eigen::Vector2d(0.5, 0.2), Eigen::Vector2d(1.0, 0.3), Eigen::Vector2d(1.5, 0.1),
-                                  Eigen::Vector2d(0.3, 0.25)}) {
+  for (const Eigen::Vector2d p :
+       {Eigen::Vector2d(0.5, 0.2), Eigen::Vector2d(1.0, 0.3), Eigen::Vector2d(1.5, 0.1), Eigen::Vector2d(0.3, 0.25)}) {
     const Eigen::Vector2d va = a.model.solver().velocity_at(p), vb = b.model.solver().velocity_at(p);
     worst = std::max(worst, (va - vb).norm());
     scale = std::max(scale, va.norm());
@@ -325,4 +334,3 @@ TEST(FluidInitialState, AnotherMeshAndElementStartFromACheckpoint) {
 INSTANTIATE_TEST_SUITE_P(Elements, FluidRemesh, ::testing::Values(std::string("p1p1"), std::string("p2p1")));
 
 }  // namespace
-

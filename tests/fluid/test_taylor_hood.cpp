@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
-
 #include <cmath>
 
 #include "fsi/common/gmsh_reader.hpp"
@@ -54,8 +53,8 @@ std::pair<double, double> l2_errors(const TaylorHoodSolver& s, const Kovasznay& 
   // 7-point degree-5 rule (barycentric L1, L2, weight).
   const double a1 = 0.059715871789770, b1 = 0.470142064105115, w1 = 0.132394152788506;
   const double a2 = 0.797426985353087, b2 = 0.101286507323456, w2 = 0.125939180544827;
-  const double rule[7][3] = {{1.0 / 3, 1.0 / 3, 0.225}, {b1, b1, w1}, {a1, b1, w1}, {b1, a1, w1},
-                             {b2, b2, w2}, {a2, b2, w2}, {b2, a2, w2}};
+  const double rule[7][3] = {
+      {1.0 / 3, 1.0 / 3, 0.225}, {b1, b1, w1}, {a1, b1, w1}, {b1, a1, w1}, {b2, b2, w2}, {a2, b2, w2}, {b2, a2, w2}};
   double ev = 0, ep = 0, mean = 0, area = 0;
   for (int pass = 0; pass < 2; ++pass) {
     for (int e = 0; e < mesh.triangle_count(); ++e) {
@@ -124,10 +123,11 @@ TEST(TaylorHood, KovasznayConvergesAtThirdOrderInVelocityAndSecondInPressure) {
   for (int i = 0; i < 3; ++i) r[i] = kovasznay_steady(sizes[i]);
   const double rate_v = std::log(r[1].ev / r[2].ev) / std::log(2.0);
   const double rate_p = std::log(r[1].ep / r[2].ep) / std::log(2.0);
-  std::printf("Kovasznay Re 40, P2/P1 Newton: velocity L2 %.3e %.3e %.3e (rate %.2f); pressure %.3e %.3e %.3e "
-              "(rate %.2f); Newton solves %d %d %d\n",
-              r[0].ev, r[1].ev, r[2].ev, rate_v, r[0].ep, r[1].ep, r[2].ep, rate_p, r[0].iterations, r[1].iterations,
-              r[2].iterations);
+  std::printf(
+      "Kovasznay Re 40, P2/P1 Newton: velocity L2 %.3e %.3e %.3e (rate %.2f); pressure %.3e %.3e %.3e "
+      "(rate %.2f); Newton solves %d %d %d\n",
+      r[0].ev, r[1].ev, r[2].ev, rate_v, r[0].ep, r[1].ep, r[2].ep, rate_p, r[0].iterations, r[1].iterations,
+      r[2].iterations);
   EXPECT_GT(rate_v, 2.8);
   EXPECT_GT(rate_p, 1.8);
   // Newton from the Stokes solution converges quadratically: a handful of solves to 1e-12.
@@ -177,9 +177,10 @@ TEST(TaylorHood, KovasznayOnAMovingMeshKeepsTheSpatialRates) {
   for (int i = 0; i < 3; ++i) r[i] = kovasznay_moving(sizes[i]);
   const double rate_v = std::log(r[1].ev / r[2].ev) / std::log(2.0);
   const double rate_p = std::log(r[1].ep / r[2].ep) / std::log(2.0);
-  std::printf("Kovasznay Re 40 on a moving mesh (ALE BDF2, 25 steps): velocity L2 %.3e %.3e %.3e (rate %.2f); pressure "
-              "%.3e %.3e %.3e (rate %.2f)\n",
-              r[0].ev, r[1].ev, r[2].ev, rate_v, r[0].ep, r[1].ep, r[2].ep, rate_p);
+  std::printf(
+      "Kovasznay Re 40 on a moving mesh (ALE BDF2, 25 steps): velocity L2 %.3e %.3e %.3e (rate %.2f); pressure "
+      "%.3e %.3e %.3e (rate %.2f)\n",
+      r[0].ev, r[1].ev, r[2].ev, rate_v, r[0].ep, r[1].ep, r[2].ep, rate_p);
   EXPECT_GT(rate_v, 2.7);
   EXPECT_GT(rate_p, 1.7);
 }
@@ -210,8 +211,10 @@ TaylorHoodSolver rotating_cylinder(const FluidMesh& mesh, bool nitsche, double p
     return Eigen::Vector2d(4 * 0.3 * x.y() * (0.41 - x.y()) / (0.41 * 0.41), 0);
   });
   s.add_dirichlet("walls", [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });
-  if (nitsche) s.set_interface({"cylinder"});
-  else s.add_dirichlet("cylinder", [](const Eigen::Vector2d& x, double) { return rotation(x); });
+  if (nitsche)
+    s.set_interface({"cylinder"});
+  else
+    s.add_dirichlet("cylinder", [](const Eigen::Vector2d& x, double) { return rotation(x); });
   return s;
 }
 
@@ -318,7 +321,8 @@ TEST(FluidMesh, QuadraticMeshHelpersAreConsistent) {
   EXPECT_EQ(quad.node_count(), linear.node_count() + (linear.node_count() + linear.triangle_count() - 1));
   for (int e = 0; e < quad.triangle_count(); ++e)
     for (int k = 0; k < 3; ++k) {
-      const Eigen::RowVector2d m = 0.5 * (quad.nodes.row(quad.triangles(e, k)) + quad.nodes.row(quad.triangles(e, (k + 1) % 3)));
+      const Eigen::RowVector2d m =
+          0.5 * (quad.nodes.row(quad.triangles(e, k)) + quad.nodes.row(quad.triangles(e, (k + 1) % 3)));
       EXPECT_NEAR((quad.nodes.row(quad.edge_nodes(e, k)) - m).norm(), 0.0, 1e-15);
     }
   EXPECT_EQ(quad.boundary_nodes({"bottom"}).size(), 9u);  // 5 vertices + 4 midpoints

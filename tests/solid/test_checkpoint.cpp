@@ -19,8 +19,10 @@ solid:
          std::to_string(elements) + R"(, 2]}
   material: {law: neo_hookean, youngs_modulus: 1.0e4, poisson_ratio: 0.3}
   density: 10.0
-  analysis: )" + analysis + R"(
-  time_scheme: )" + scheme + R"(
+  analysis: )" +
+         analysis + R"(
+  time_scheme: )" +
+         scheme + R"(
   clamp: left
   interface: [top, right, bottom]
   probes: [{name: tip, point: [1.0, 0.05]}]
@@ -126,7 +128,8 @@ TEST(SolidOverflow, HugeInterfaceForceIsNotConverged) {
                     << r.interface_displacement.norm() << ")";
     } catch (const fsi::SolverError& e) {
       const std::string what = e.what();
-      EXPECT_TRUE(what.find("Newton did not converge") != std::string::npos || what.find("inverted") != std::string::npos)
+      EXPECT_TRUE(what.find("Newton did not converge") != std::string::npos ||
+                  what.find("inverted") != std::string::npos)
           << what;
     }
   }

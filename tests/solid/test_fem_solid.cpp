@@ -48,8 +48,10 @@ solid:
   mesh: {type: rectangle, origin: [0, 0], size: [1.0, 0.1], elements: [20, 2]}
   material: {law: neo_hookean, youngs_modulus: 1.0e4, poisson_ratio: 0.3}
   density: 10.0
-  analysis: )" + analysis + R"(
-  time_scheme: )" + scheme + R"(
+  analysis: )" +
+         analysis + R"(
+  time_scheme: )" +
+         scheme + R"(
   clamp: left
   interface: [top, right, bottom]
   probes: [{name: tip, point: [1.0, 0.05]}]
@@ -80,7 +82,8 @@ TEST_P(TurekHronStatic, EnhancedStrainOn80x4WithinHalfAPercent) {
                                       {"solid.element=q4_eas", "solid.mesh.elements=[80, 4]"});
   const auto r = run_scene(scene, 1, 1.0);
   const double ux = r.probes.at("A_x"), uy = r.probes.at("A_y");
-  std::printf("%s, q4_eas 80 x 4: A_x %.2f%%, A_y %.2f%%\n", name.c_str(), 100 * (ux / ux_ref - 1), 100 * (uy / uy_ref - 1));
+  std::printf("%s, q4_eas 80 x 4: A_x %.2f%%, A_y %.2f%%\n", name.c_str(), 100 * (ux / ux_ref - 1),
+              100 * (uy / uy_ref - 1));
   EXPECT_NEAR(ux, ux_ref, 0.005 * std::abs(ux_ref));
   EXPECT_NEAR(uy, uy_ref, 0.005 * std::abs(uy_ref));
 }
@@ -184,7 +187,8 @@ solid:
     scene.check_all_used("solid");
     const auto n = static_cast<Eigen::Index>(solid.interface().nodes());
     Eigen::VectorXd f = Eigen::VectorXd::Zero(2 * n);
-    for (Eigen::Index i = 0; i < n; ++i) f(2 * i) = 1e-6 * (1 + solid.interface().coordinates(i, 1));  // small: linear regime
+    for (Eigen::Index i = 0; i < n; ++i)
+      f(2 * i) = 1e-6 * (1 + solid.interface().coordinates(i, 1));  // small: linear regime
     fsi::StepInfo info{dt, dt, 1, 0};
     const auto r = solid.solve_step(info, f);
     newton = r.newton_iterations;
@@ -203,9 +207,10 @@ solid:
       // int_boundary v_x ds, exactly (v is linear on each edge).
       double boundary_integral = 0;
       for (const auto& e : sys.mesh().edges({"top", "right", "bottom", "left"}))
-        boundary_integral += 0.5 * (sys.mesh().nodes.row(e[0]) - sys.mesh().nodes.row(e[1])).norm() *
-                             (v(2 * e[0]) + v(2 * e[1]));
-      EXPECT_NEAR(ones_x.dot(sys.damping() * v), g * boundary_integral, 1e-12 * std::abs(g * boundary_integral) + 1e-20);
+        boundary_integral +=
+            0.5 * (sys.mesh().nodes.row(e[0]) - sys.mesh().nodes.row(e[1])).norm() * (v(2 * e[0]) + v(2 * e[1]));
+      EXPECT_NEAR(ones_x.dot(sys.damping() * v), g * boundary_integral,
+                  1e-12 * std::abs(g * boundary_integral) + 1e-20);
     }
     return r.interface_displacement.cwiseAbs().maxCoeff();
   };
@@ -280,8 +285,8 @@ TEST(FemSolidConfig, UnknownKeysAreReported) {
 }
 
 TEST(FemSolidErrors, NewtonFailureNamesTheStep) {
-  const auto scene = fsi::Scene::parse(beam_scene("  gravity: [0, -100]\n  newton: {max_iterations: 1}\n", "static"),
-                                       "beam.yaml");
+  const auto scene =
+      fsi::Scene::parse(beam_scene("  gravity: [0, -100]\n  newton: {max_iterations: 1}\n", "static"), "beam.yaml");
   FemSolid solid;
   solid.configure(scene.section("solid"), {1, 1, 0, {}});
   try {
@@ -343,8 +348,8 @@ TEST(Dynamics, Bdf2IsSecondOrderBdf1FirstOrder) {
   auto rate = [&](const std::string& scheme) {
     const double e1 = std::abs(tip_at_1(scheme, 0.02) - reference), e2 = std::abs(tip_at_1(scheme, 0.01) - reference),
                  e3 = std::abs(tip_at_1(scheme, 0.005) - reference);
-    std::printf("%s: errors %.3e %.3e %.3e (reference %.6e), rates %.2f %.2f\n", scheme.c_str(), e1, e2, e3,
-                reference, std::log2(e1 / e2), std::log2(e2 / e3));
+    std::printf("%s: errors %.3e %.3e %.3e (reference %.6e), rates %.2f %.2f\n", scheme.c_str(), e1, e2, e3, reference,
+                std::log2(e1 / e2), std::log2(e2 / e3));
     return std::log2(e2 / e3);
   };
   EXPECT_NEAR(rate("bdf2"), 2.0, 0.25);
@@ -373,7 +378,8 @@ TEST(FemSolidGmsh, SameResultAsTheBuiltInRectangle) {
     // Quads written clockwise on purpose: the reader must reorder them.
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
-        out << e++ << " 3 2 1 3 " << id(i, j) << " " << id(i, j + 1) << " " << id(i + 1, j + 1) << " " << id(i + 1, j) << "\n";
+        out << e++ << " 3 2 1 3 " << id(i, j) << " " << id(i, j + 1) << " " << id(i + 1, j + 1) << " " << id(i + 1, j)
+            << "\n";
     out << "$EndElements\n";
   }
   const std::string common = R"(
@@ -388,7 +394,8 @@ TEST(FemSolidGmsh, SameResultAsTheBuiltInRectangle) {
                                             "gmsh.yaml");
   const auto rect_scene = fsi::Scene::parse(
       "solid:\n  model: fem\n  mesh: {type: rectangle, origin: [0, 0], size: [1.0, 0.1], elements: [10, 2]}\n"
-      "  clamp: left\n  interface: top\n" + common,
+      "  clamp: left\n  interface: top\n" +
+          common,
       "rect.yaml");
   const auto a = run_scene(gmsh_scene, 1, 1.0), b = run_scene(rect_scene, 1, 1.0);
   EXPECT_NEAR(a.probes.at("tip_y"), b.probes.at("tip_y"), 1e-12);
@@ -422,7 +429,8 @@ solid:
   clamp: left
   probes: [{name: tip, point: [1.0, 0.05]}]
 )";
-  const auto a = run_scene(fsi::Scene::parse(base + "  tractions: [{boundary: right, traction: [0, -0.1]}]\n", "t"), 1, 1.0);
+  const auto a =
+      run_scene(fsi::Scene::parse(base + "  tractions: [{boundary: right, traction: [0, -0.1]}]\n", "t"), 1, 1.0);
   const auto b = run_scene(fsi::Scene::parse(base + "  point_loads:\n"
                                                     "    - {point: [1.0, 0.0], force: [0, -0.0025]}\n"
                                                     "    - {point: [1.0, 0.05], force: [0, -0.005]}\n"

@@ -81,7 +81,8 @@ TEST_P(MaterialTangent, MatchesFiniteDifferences) {
     const Matrix2 dF = Matrix2::Random();
     const double h = 1e-6;
     const Vector3 fd = (mat->stress(Kinematics::from_deformation_gradient(F + h * dF)) -
-                        mat->stress(Kinematics::from_deformation_gradient(F - h * dF))) / (2 * h);
+                        mat->stress(Kinematics::from_deformation_gradient(F - h * dF))) /
+                       (2 * h);
     const Matrix2 dE = 0.5 * (F.transpose() * dF + dF.transpose() * F);
     const Vector3 predicted = D * Vector3(dE(0, 0), dE(1, 1), 2 * dE(0, 1));
     EXPECT_LT((fd - predicted).norm(), 1e-7 * predicted.norm()) << GetParam() << " trial " << trial;
@@ -97,7 +98,8 @@ TEST_P(MaterialTangent, StressIsEnergyDerivative) {
   const Matrix2 dF = Matrix2::Random();
   const double h = 1e-6;
   const double dW = (mat->energy(Kinematics::from_deformation_gradient(F + h * dF)) -
-                     mat->energy(Kinematics::from_deformation_gradient(F - h * dF))) / (2 * h);
+                     mat->energy(Kinematics::from_deformation_gradient(F - h * dF))) /
+                    (2 * h);
   const Matrix2 dE = 0.5 * (F.transpose() * dF + dF.transpose() * F);
   EXPECT_NEAR(dW, S(0) * dE(0, 0) + S(1) * dE(1, 1) + 2 * S(2) * dE(0, 1), 1e-8);
 }

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <cstring>
 #include <random>
@@ -94,20 +93,20 @@ TEST_P(LinearProblem, ConvergesInAtMostNPlusOneUpdates) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Schemes, LinearProblem,
-    ::testing::Values(Variant{"iqn-ils", QrFilter::Qr2, Preconditioner::None},
-                      Variant{"iqn-ils", QrFilter::Qr1, Preconditioner::None},
-                      Variant{"iqn-ils", QrFilter::Qr3, Preconditioner::ResidualSum},
-                      Variant{"iqn-imvj", QrFilter::Qr2, Preconditioner::None},
-                      Variant{"iqn-imvj", QrFilter::Qr1, Preconditioner::None},
-                      Variant{"iqn-imvj", QrFilter::Qr3, Preconditioner::ResidualSum}),
-    [](const auto& info) {
-      std::string name = info.param.scheme + "_qr" + std::to_string(static_cast<int>(info.param.filter) + 1) +
-                         (info.param.pre == Preconditioner::ResidualSum ? "_residual_sum" : "");
-      std::replace(name.begin(), name.end(), '-', '_');
-      return name;
-    });
+INSTANTIATE_TEST_SUITE_P(Schemes, LinearProblem,
+                         ::testing::Values(Variant{"iqn-ils", QrFilter::Qr2, Preconditioner::None},
+                                           Variant{"iqn-ils", QrFilter::Qr1, Preconditioner::None},
+                                           Variant{"iqn-ils", QrFilter::Qr3, Preconditioner::ResidualSum},
+                                           Variant{"iqn-imvj", QrFilter::Qr2, Preconditioner::None},
+                                           Variant{"iqn-imvj", QrFilter::Qr1, Preconditioner::None},
+                                           Variant{"iqn-imvj", QrFilter::Qr3, Preconditioner::ResidualSum}),
+                         [](const auto& info) {
+                           std::string name = info.param.scheme + "_qr" +
+                                              std::to_string(static_cast<int>(info.param.filter) + 1) +
+                                              (info.param.pre == Preconditioner::ResidualSum ? "_residual_sum" : "");
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 // Steps with one A and a new b each: the iterations per step, IQN-IMVJ in a given mode.
 std::vector<int> step_updates(CouplingSettings s, int steps, int n = 10) {
@@ -123,10 +122,10 @@ std::vector<int> step_updates(CouplingSettings s, int steps, int n = 10) {
 TEST(IqnImvj, WithoutRestartLaterStepsConvergeFasterWithTheJacobianCarriedOver) {
   const auto imvj = step_updates(quasi_newton("iqn-imvj"), 5);
   const auto ils = step_updates(quasi_newton("iqn-ils"), 5);  // no reuse: every step starts afresh
-  ASSERT_GE(imvj[0], 5);  // n + 1 = 11 here
+  ASSERT_GE(imvj[0], 5);                                      // n + 1 = 11 here
   for (int step = 1; step < 5; ++step) {
     EXPECT_LT(imvj[step], imvj[0]) << "step " << step;
-    EXPECT_LE(imvj[step], 2) << "step " << step;  // J exact after the first step: one update (1 here)
+    EXPECT_LE(imvj[step], 2) << "step " << step;          // J exact after the first step: one update (1 here)
     EXPECT_GE(ils[step], ils[0] - 1) << "step " << step;  // IQN-ILS without reuse: n + 1 every step
   }
 }

@@ -2,6 +2,7 @@
 // checksummed, pruned), scene comparison, table resumption, the --out policy and the
 // accelerator's saved history.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -9,7 +10,6 @@
 #include <fstream>
 #include <functional>
 #include <limits>
-#include <unistd.h>
 
 #include "fsi/common/run_report.hpp"
 #include "fsi/common/state.hpp"
@@ -148,8 +148,9 @@ TEST(CsvWriter, ResumeKeepsTheFirstRowsAndAppends) {
     auto w = fsi::CsvWriter::resume(dir / "t.csv", 3, {"step", "x"});
     w.row(std::vector<double>{4, 0.4});
   }
-  EXPECT_EQ(slurp(dir / "t.csv"), "step,x\n1,0.10000000000000001\n2,0.20000000000000001\n3,0.30000000000000004\n4,"
-                                  "0.40000000000000002\n");
+  EXPECT_EQ(slurp(dir / "t.csv"),
+            "step,x\n1,0.10000000000000001\n2,0.20000000000000001\n3,0.30000000000000004\n4,"
+            "0.40000000000000002\n");
   EXPECT_THROW(fsi::CsvWriter::resume(dir / "t.csv", 9), std::runtime_error);
   EXPECT_THROW(fsi::CsvWriter::resume(dir / "t.csv", 1, {"step", "y"}), std::runtime_error);
   fs::remove_all(dir);

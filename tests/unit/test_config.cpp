@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "fsi/common/config.hpp"
-#include "fsi/common/utf8.hpp"
 #include "fsi/common/standalone.hpp"
+#include "fsi/common/utf8.hpp"
 
 namespace {
 
@@ -114,10 +114,12 @@ TEST(Config, DuplicateKeyNamesBothLines) {
 TEST(Utf8, ValidTextUnchangedInvalidBytesEscaped) {
   EXPECT_EQ(fsi::valid_utf8("relaxation \xCE\xB2 = 0.5, \xE2\x82\xAC, \xF0\x9F\x98\x80"),
             "relaxation \xCE\xB2 = 0.5, \xE2\x82\xAC, \xF0\x9F\x98\x80");
-  EXPECT_EQ(fsi::valid_utf8(std::string("entry 'a\xFF\x80" "b'")), "entry 'a\\xFF\\x80b'");
-  EXPECT_EQ(fsi::valid_utf8("\xC0\xAF"), "\\xC0\\xAF");              // overlong '/'
+  EXPECT_EQ(fsi::valid_utf8(std::string("entry 'a\xFF\x80"
+                                        "b'")),
+            "entry 'a\\xFF\\x80b'");
+  EXPECT_EQ(fsi::valid_utf8("\xC0\xAF"), "\\xC0\\xAF");           // overlong '/'
   EXPECT_EQ(fsi::valid_utf8("\xED\xA0\x80"), "\\xED\\xA0\\x80");  // a surrogate
-  EXPECT_EQ(fsi::valid_utf8("cut \xE2\x82"), "cut \\xE2\\x82");      // truncated at the end
+  EXPECT_EQ(fsi::valid_utf8("cut \xE2\x82"), "cut \\xE2\\x82");   // truncated at the end
   EXPECT_EQ(fsi::valid_utf8(std::string("nul\0ok", 6)), std::string("nul\0ok", 6));
 }
 

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
-
 #include <fstream>
 #include <sstream>
 
@@ -71,7 +70,8 @@ class PenaltyFluid : public fsi::FluidModel {
           for (int c = 0; c < 2; ++c) A(2 * i + c, 2 * j + c) = gamma_ * md(i, j) + (i == j) * inertia_ / dt;
       v_ = A.lu().solve(inertia_ / dt * v_n_ - mp + gamma_ * fsi::apply_nodal(m, v_s));
     }
-    const Eigen::VectorXd reaction = (dt > 0 ? Eigen::VectorXd(inertia_ / dt * (v_ - v_n_)) : Eigen::VectorXd::Zero(2 * n)) + mp;
+    const Eigen::VectorXd reaction =
+        (dt > 0 ? Eigen::VectorXd(inertia_ / dt * (v_ - v_n_)) : Eigen::VectorXd::Zero(2 * n)) + mp;
     fsi::FluidLoads out;
     out.velocity_integral = fsi::apply_nodal(m, v_);
     out.traction_force = reaction + gamma_ * (out.velocity_integral - fsi::apply_nodal(m, v_s));
@@ -90,7 +90,9 @@ class PenaltyFluid : public fsi::FluidModel {
   bool supports_output() const override { return false; }
   bool supports_checkpoint() const override { return true; }
   void save_state(fsi::StateArchive& state) override { state.put("penalty_fluid.v_n", v_n_); }
-  void load_state(const fsi::StateArchive& state) override { v_n_ = v_ = state.vector("penalty_fluid.v_n", v_n_.size()); }
+  void load_state(const fsi::StateArchive& state) override {
+    v_n_ = v_ = state.vector("penalty_fluid.v_n", v_n_.size());
+  }
 
  private:
   Eigen::MatrixX2d x_;
@@ -104,8 +106,8 @@ std::string scene_text(int algorithm, double gamma, const std::string& extra) {
     << "time: {dt: 0.01, end: 0.2, checkpoint_every: 10}\n"
     << "coupling:\n  algorithm: " << algorithm << "\n  gamma_n1: " << gamma << "\n  relaxation: 0.5\n"
     << "  acceleration: iqn-ils\n  iqn: {reuse_steps: 0}\n"
-    << "  iterations: {max: 60, tolerance: 1.0e-13, stop_if_not_converged: false}\n" << extra
-    << "solid:\n  model: fem\n"
+    << "  iterations: {max: 60, tolerance: 1.0e-13, stop_if_not_converged: false}\n"
+    << extra << "solid:\n  model: fem\n"
     << "  mesh: {type: rectangle, origin: [0.0, 0.0], size: [1.0, 0.1], elements: [12, 2]}\n"
     << "  material: {law: saint_venant_kirchhoff, youngs_modulus: 1.0e5, poisson_ratio: 0.3}\n"
     << "  density: 10.0\n  analysis: dynamic\n  time_scheme: bdf1\n  clamp: left\n  interface: [top]\n"
@@ -124,9 +126,9 @@ struct Result {
 // checkpoint of step 10 there and continues from it, as fsi run --from does.
 Result run(int algorithm, double gamma, const std::string& extra = "", const fs::path& fork_from = {},
            bool keep = false) {
-  const auto dir = fs::temp_directory_path() / ("fsi_consistent_" + std::to_string(::getpid()) + "_" +
-                                                std::to_string(algorithm) + "_" + std::to_string(int(gamma)) +
-                                                std::to_string(extra.size()) + (fork_from.empty() ? "" : "_fork"));
+  const auto dir = fs::temp_directory_path() /
+                   ("fsi_consistent_" + std::to_string(::getpid()) + "_" + std::to_string(algorithm) + "_" +
+                    std::to_string(int(gamma)) + std::to_string(extra.size()) + (fork_from.empty() ? "" : "_fork"));
   fs::remove_all(dir);
   fs::create_directories(dir / "out");
   if (!fork_from.empty()) {

@@ -2,10 +2,9 @@
 // the closed-form added-mass stability limits of Algorithms 1 and 2, and run outcomes.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <fstream>
 #include <sstream>
-
-#include <Eigen/Dense>
 
 #include "fsi/coupling/acceleration.hpp"
 #include "fsi/coupling/coupler.hpp"
@@ -49,9 +48,12 @@ void read_csv(const fs::path& path, std::vector<std::string>& columns, std::vect
 
 Run run_scene(const std::vector<std::string>& overrides) {
   const auto scene = fsi::Scene::load(fs::path(FSI_SOURCE_DIR) / "configs/sdof_model.yaml", overrides);
-  const auto out = fs::temp_directory_path() / ("fsi_unit_" + std::to_string(::getpid()) + "_" +
-                                                std::to_string(std::hash<std::string>{}(
-                                                    [&] { std::string s; for (auto& o : overrides) s += o + ";"; return s; }())));
+  const auto out = fs::temp_directory_path() /
+                   ("fsi_unit_" + std::to_string(::getpid()) + "_" + std::to_string(std::hash<std::string>{}([&] {
+                      std::string s;
+                      for (auto& o : overrides) s += o + ";";
+                      return s;
+                    }())));
   fs::remove_all(out);
   fs::create_directories(out);
   fsi::models::SdofSolid solid;
@@ -73,8 +75,8 @@ std::vector<double> recurrence(double gamma, int steps, double dt = 0.02) {
   std::vector<double> out;
   for (int n = 0; n < steps; ++n) {
     // m (d' - d - dt v)/dt^2 + (c+g)(d' - d)/dt + k d' = F + g v
-    const double dn = (F + gamma * v + m * (d / (dt * dt) + v / dt) + (c + gamma) * d / dt) /
-                      (m / (dt * dt) + (c + gamma) / dt + k);
+    const double dn =
+        (F + gamma * v + m * (d / (dt * dt) + v / dt) + (c + gamma) * d / dt) / (m / (dt * dt) + (c + gamma) / dt + k);
     v = (dn - d) / dt;
     d = dn;
     out.push_back(d);
@@ -148,11 +150,18 @@ TEST_P(AddedMass, ConvergesBelowAndDivergesAboveTheClosedFormLimit) {
   const double limit = beta_limit(algorithm, gamma, m, c, k, m_a, dt);
   ASSERT_LT(1.1 * limit, 1.0) << "pick parameters with the limit below 1";
   auto scene_for = [&](double beta) {
-    return std::vector<std::string>{
-        "coupling.algorithm=" + std::to_string(algorithm), "coupling.gamma_n1=" + std::to_string(gamma),
-        "coupling.relaxation=" + std::to_string(beta), "coupling.iterations.max=400",
-        "coupling.iterations.tolerance=1e-10", "time.end=0.2", "time.dt=" + std::to_string(dt),
-        "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"};
+    return std::vector<std::string>{"coupling.algorithm=" + std::to_string(algorithm),
+                                    "coupling.gamma_n1=" + std::to_string(gamma),
+                                    "coupling.relaxation=" + std::to_string(beta),
+                                    "coupling.iterations.max=400",
+                                    "coupling.iterations.tolerance=1e-10",
+                                    "time.end=0.2",
+                                    "time.dt=" + std::to_string(dt),
+                                    "solid.mass=1",
+                                    "solid.damping=0.5",
+                                    "solid.stiffness=4",
+                                    "fluid.added_mass=10",
+                                    "fluid.force=1"};
   };
   const auto below = run_scene(scene_for(0.9 * limit));
   EXPECT_EQ(below.outcome.status, "completed") << below.outcome.reason;
@@ -181,9 +190,8 @@ void expect_monolithic_added_mass(const std::vector<double>& dx, const std::stri
 TEST(AddedMass, ConvergedSolutionIsTheMonolithicOne) {
   // Converged coupling iterations solve (m + m_a) a + c v + k d = F exactly (BDF1).
   const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=0.1", "coupling.iterations.max=500",
-                              "coupling.iterations.tolerance=1e-12", "time.end=0.5", "time.dt=0.01",
-                              "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10",
-                              "fluid.force=1"});
+                              "coupling.iterations.tolerance=1e-12", "time.end=0.5", "time.dt=0.01", "solid.mass=1",
+                              "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"});
   ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
   expect_monolithic_added_mass(run.column("solid.d_x"), "");
 }
@@ -208,7 +216,8 @@ TEST(Outcome, OutOfRangeRelaxationIsRejected) {
   for (const char* beta : {"0", "-0.5"}) {
     const auto run = run_scene({std::string("coupling.relaxation=") + beta});
     EXPECT_EQ(run.outcome.status, "failed") << beta;
-    EXPECT_NE(run.outcome.reason.find("'coupling.relaxation' (beta) must be > 0"), std::string::npos) << run.outcome.reason;
+    EXPECT_NE(run.outcome.reason.find("'coupling.relaxation' (beta) must be > 0"), std::string::npos)
+        << run.outcome.reason;
   }
   const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=2.5"});
   EXPECT_EQ(run.outcome.status, "failed");
@@ -235,9 +244,9 @@ TEST(Measures, ConvergedOnTheDisplacementChangeWithItsValuesInIterationsCsv) {
   ASSERT_EQ(run.rows.size(), 50u);
   int steps_checked = 0;
   for (std::size_t i = 0; i < run.iteration_rows.size(); ++i) {
-    const bool last_of_step = i + 1 == run.iteration_rows.size() ||
-                              run.iteration_rows[i + 1][static_cast<std::size_t>(step)] !=
-                                  run.iteration_rows[i][static_cast<std::size_t>(step)];
+    const bool last_of_step =
+        i + 1 == run.iteration_rows.size() || run.iteration_rows[i + 1][static_cast<std::size_t>(step)] !=
+                                                  run.iteration_rows[i][static_cast<std::size_t>(step)];
     if (!last_of_step) continue;
     EXPECT_LT(run.iteration_rows[i][static_cast<std::size_t>(d)], 1e-12);
     EXPECT_LT(run.iteration_rows[i][static_cast<std::size_t>(t)], 1e-9);
@@ -257,8 +266,8 @@ TEST(Measures, AStrictMeasureNotMetEndsTheRunNamingIt) {
 }
 
 TEST(Measures, ToleranceAndMeasuresTogetherAreRefused) {
-  const auto run = run_scene({"coupling.iterations.tolerance=1e-6",
-                              "coupling.iterations.measures=[{quantity: force, limit: 1.0e-6}]"});
+  const auto run = run_scene(
+      {"coupling.iterations.tolerance=1e-6", "coupling.iterations.measures=[{quantity: force, limit: 1.0e-6}]"});
   EXPECT_EQ(run.outcome.status, "failed");
   EXPECT_NE(run.outcome.reason.find("either 'tolerance'"), std::string::npos) << run.outcome.reason;
 }
@@ -276,10 +285,17 @@ namespace {
 TEST(Aitken, ConvergesAboveTheConstantRelaxationLimitInAFewIterations) {
   // beta = 0.5 is far above Algorithm 1's limit 0.1827 for this problem; Aitken's secant
   // update finds the optimal relaxation of this linear interface problem in one iteration.
-  const std::vector<std::string> base{"coupling.algorithm=1", "coupling.relaxation=0.5",
-                                      "coupling.iterations.max=50", "coupling.iterations.tolerance=1e-12",
-                                      "time.end=0.2", "time.dt=0.01", "solid.mass=1", "solid.damping=0.5",
-                                      "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"};
+  const std::vector<std::string> base{"coupling.algorithm=1",
+                                      "coupling.relaxation=0.5",
+                                      "coupling.iterations.max=50",
+                                      "coupling.iterations.tolerance=1e-12",
+                                      "time.end=0.2",
+                                      "time.dt=0.01",
+                                      "solid.mass=1",
+                                      "solid.damping=0.5",
+                                      "solid.stiffness=4",
+                                      "fluid.added_mass=10",
+                                      "fluid.force=1"};
   auto constant = base;
   constant.push_back("coupling.acceleration=constant");
   EXPECT_EQ(run_scene(constant).outcome.status, "diverged");
@@ -379,9 +395,9 @@ TEST(IqnIls, CouplerConvergesAboveTheConstantRelaxationLimit) {
   // The added-mass model of the Aitken test with beta = 0.5 (limit 0.1827): IQN-ILS and its
   // reuse take the coupler to the monolithic solution in a few iterations per step.
   const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=0.5", "coupling.iterations.max=50",
-                              "coupling.iterations.tolerance=1e-12", "time.end=0.2", "time.dt=0.01",
-                              "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10",
-                              "fluid.force=1", "coupling.acceleration=iqn-ils", "coupling.iqn={reuse_steps: 4}"});
+                              "coupling.iterations.tolerance=1e-12", "time.end=0.2", "time.dt=0.01", "solid.mass=1",
+                              "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1",
+                              "coupling.acceleration=iqn-ils", "coupling.iqn={reuse_steps: 4}"});
   ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
   const auto iterations = run.column("coupling.iterations");
   for (double k : iterations) EXPECT_LE(k, 4);
@@ -407,7 +423,9 @@ fsi::coupling::CouplingSettings run_scene_settings(const std::vector<std::string
 TEST(IqnIls, SettingsOnlyWithIqnIls) {
   EXPECT_THROW(run_scene_settings({"coupling.acceleration=aitken", "coupling.iqn={reuse_steps: 4}"}), fsi::ConfigError);
   EXPECT_THROW(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={reuse_step: 4}"}), fsi::ConfigError);
-  EXPECT_EQ(run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={reuse_steps: 4, filter: 0.01}"}).reuse_steps, 4);
+  EXPECT_EQ(
+      run_scene_settings({"coupling.acceleration=iqn-ils", "coupling.iqn={reuse_steps: 4, filter: 0.01}"}).reuse_steps,
+      4);
 }
 
 TEST(InterfaceMapRbf, SettingsMappingAndSupportRadius) {
@@ -420,8 +438,7 @@ TEST(InterfaceMapRbf, SettingsMappingAndSupportRadius) {
   EXPECT_DOUBLE_EQ(run_scene_settings({"coupling.mapping=rbf-wendland-c2"}).mapping.support_radius, 0.0);
   EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf"}), fsi::ConfigError);
   EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf-tps", "coupling.support_radius=0.05"}), fsi::ConfigError);
-  EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf-wendland-c2", "coupling.support_radius=0"}),
-               fsi::ConfigError);
+  EXPECT_THROW(run_scene_settings({"coupling.mapping=rbf-wendland-c2", "coupling.support_radius=0"}), fsi::ConfigError);
 }
 
 }  // namespace
@@ -435,11 +452,11 @@ TEST(IqnImvj, CouplerConvergesWithAlgorithms1And2AboveTheConstantRelaxationLimit
   for (const char* algorithm : {"1", "2"})
     for (const char* iqn : {"{imvj: {restart: none}}", "{imvj: {restart: rs-svd, chunk_size: 3}, filter_type: qr3}",
                             "{imvj: {restart: rs-ls, chunk_size: 2}, preconditioner: residual-sum}"}) {
-      const auto run = run_scene({std::string("coupling.algorithm=") + algorithm, "coupling.gamma_n1=10",
-                                  "coupling.relaxation=0.5", "coupling.iterations.max=50",
-                                  "coupling.iterations.tolerance=1e-12", "time.end=0.2", "time.dt=0.01", "solid.mass=1",
-                                  "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1",
-                                  "coupling.acceleration=iqn-imvj", std::string("coupling.iqn=") + iqn});
+      const auto run =
+          run_scene({std::string("coupling.algorithm=") + algorithm, "coupling.gamma_n1=10", "coupling.relaxation=0.5",
+                     "coupling.iterations.max=50", "coupling.iterations.tolerance=1e-12", "time.end=0.2",
+                     "time.dt=0.01", "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4", "fluid.added_mass=10",
+                     "fluid.force=1", "coupling.acceleration=iqn-imvj", std::string("coupling.iqn=") + iqn});
       ASSERT_EQ(run.outcome.status, "completed") << algorithm << " " << iqn << ": " << run.outcome.reason;
       const auto iterations = run.column("coupling.iterations");
       for (std::size_t n = 1; n < iterations.size(); ++n) EXPECT_LE(iterations[n], 3) << algorithm << " " << iqn;
@@ -469,7 +486,7 @@ namespace {
 
 // The added-mass scene of the tests above (m 1, c 0.5, k 4, m_a 10, F 1, dt 0.01, 20 steps).
 std::vector<std::string> added_mass_scene(std::vector<std::string> more) {
-  std::vector<std::string> s{"time.end=0.2", "time.dt=0.01", "solid.mass=1", "solid.damping=0.5",
+  std::vector<std::string> s{"time.end=0.2",      "time.dt=0.01",        "solid.mass=1", "solid.damping=0.5",
                              "solid.stiffness=4", "fluid.added_mass=10", "fluid.force=1"};
   s.insert(s.end(), more.begin(), more.end());
   return s;
@@ -501,13 +518,14 @@ TEST(Parallel, JacobiRelaxationLimitIsTheSerialOne) {
   // the serial limit, reached at the rate sqrt((m_a - G) / (m_eff + m_a)) at best instead of 0.
   // Also with the automatic Robin parameter (G = m_s = 1, the same as gamma_N1 = 100).
   for (const std::vector<std::string>& robin : {std::vector<std::string>{"coupling.algorithm=1"},
-                                                 {"coupling.algorithm=2", "coupling.gamma_n1=100"},
-                                                 {"coupling.algorithm=2", "coupling.robin_auto=solid"}}) {
+                                                {"coupling.algorithm=2", "coupling.gamma_n1=100"},
+                                                {"coupling.algorithm=2", "coupling.robin_auto=solid"}}) {
     const double gamma = robin.size() > 1 ? 100 : 0;
     const double limit = beta_limit(robin.size() > 1 ? 2 : 1, gamma, 1, 0.5, 4, 10, 0.01);
     for (const double factor : {0.9, 1.1}) {
-      auto scene = added_mass_scene({"coupling.scheme=parallel", "coupling.relaxation=" + std::to_string(factor * limit),
-                                     "coupling.iterations.max=3000", "coupling.iterations.tolerance=1e-8"});
+      auto scene =
+          added_mass_scene({"coupling.scheme=parallel", "coupling.relaxation=" + std::to_string(factor * limit),
+                            "coupling.iterations.max=3000", "coupling.iterations.tolerance=1e-8"});
       scene.insert(scene.end(), robin.begin(), robin.end());
       const auto run = run_scene(scene);
       EXPECT_EQ(run.outcome.status, factor < 1 ? "completed" : "diverged") << robin.back() << " " << factor;
@@ -525,7 +543,7 @@ std::vector<double> loosely_coupled_added_mass(bool parallel, double m, double m
   for (int n = 0; n < steps; ++n) {
     const double dn = (force + m * (d / (dt * dt) + v / dt) + G / dt * d / dt) / (m / (dt * dt) + G / dt / dt);
     const double vn = (dn - d) / dt;
-    const double v_in = parallel ? v : vn;  // the fluid's interface velocity
+    const double v_in = parallel ? v : vn;                    // the fluid's interface velocity
     force = 1 - m_a * (v_in - v_fluid) / dt + G / dt * v_in;  // -F* = force on the solid + gamma mu v
     v_fluid = v_in, d = dn, v = vn;
     out.push_back(d);
@@ -543,15 +561,17 @@ TEST(RobinAuto, LooselyCoupledAddedMassStabilityLimit) {
   for (const bool parallel : {false, true})
     for (const double factor : {0.9, 1.1}) {
       const double m_a = factor * 2 * m;
-      const auto run = run_scene({"coupling.algorithm=2", "coupling.gamma_n1=1", "coupling.robin_auto=solid",
-                                  "coupling.relaxation=1", "coupling.iterations.max=1", "coupling.iterations.tolerance=0",
-                                  "coupling.force_limit=1e6", std::string("coupling.scheme=") + (parallel ? "parallel" : "serial"),
-                                  "time.dt=0.01", "time.end=6", "solid.mass=1", "solid.damping=0", "solid.stiffness=0",
-                                  "fluid.added_mass=" + std::to_string(m_a), "fluid.force=1"});
+      const auto run =
+          run_scene({"coupling.algorithm=2", "coupling.gamma_n1=1", "coupling.robin_auto=solid",
+                     "coupling.relaxation=1", "coupling.iterations.max=1", "coupling.iterations.tolerance=0",
+                     "coupling.force_limit=1e6", std::string("coupling.scheme=") + (parallel ? "parallel" : "serial"),
+                     "time.dt=0.01", "time.end=6", "solid.mass=1", "solid.damping=0", "solid.stiffness=0",
+                     "fluid.added_mass=" + std::to_string(m_a), "fluid.force=1"});
       const auto expected = loosely_coupled_added_mass(parallel, m, m_a, m, dt, 600);
       const auto d = run.column("solid.d_x");
       for (std::size_t n = 0; n < d.size(); ++n)
-        ASSERT_NEAR(d[n], expected[n], 1e-9 * (1 + std::abs(expected[n]))) << parallel << " " << factor << " step " << n + 1;
+        ASSERT_NEAR(d[n], expected[n], 1e-9 * (1 + std::abs(expected[n])))
+            << parallel << " " << factor << " step " << n + 1;
       if (factor < 1) {
         EXPECT_EQ(run.outcome.status, "completed") << parallel << ": " << run.outcome.reason;
       } else {
@@ -560,10 +580,10 @@ TEST(RobinAuto, LooselyCoupledAddedMassStabilityLimit) {
       }
     }
   // Algorithm 1 (no Robin term on the solid) at m_a = 1.8 m is past its limit m_a < m.
-  const auto alg1 = run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0", "coupling.relaxation=1",
-                               "coupling.iterations.max=1", "coupling.force_limit=1e6", "time.dt=0.01", "time.end=6",
-                               "solid.mass=1", "solid.damping=0", "solid.stiffness=0", "fluid.added_mass=1.8",
-                               "fluid.force=1"});
+  const auto alg1 =
+      run_scene({"coupling.algorithm=1", "coupling.gamma_n1=0", "coupling.relaxation=1", "coupling.iterations.max=1",
+                 "coupling.force_limit=1e6", "time.dt=0.01", "time.end=6", "solid.mass=1", "solid.damping=0",
+                 "solid.stiffness=0", "fluid.added_mass=1.8", "fluid.force=1"});
   EXPECT_EQ(alg1.outcome.status, "diverged");
 }
 

@@ -198,7 +198,8 @@ TEST(InterfaceMapRbf, ReproducesAffineFieldsAndRigidMotionsExactly) {
   const Eigen::Vector2d centre(0.2, 0.2);
   const std::vector<std::pair<const char*, std::function<Eigen::Vector2d(Eigen::Vector2d)>>> fields = {
       {"translation", [](Eigen::Vector2d) { return Eigen::Vector2d(0.01, -0.03); }},
-      {"rotation 30 deg", [&](Eigen::Vector2d x) { return Eigen::Vector2d((rot - Eigen::Matrix2d::Identity()) * (x - centre)); }},
+      {"rotation 30 deg",
+       [&](Eigen::Vector2d x) { return Eigen::Vector2d((rot - Eigen::Matrix2d::Identity()) * (x - centre)); }},
       {"affine", [](Eigen::Vector2d x) { return Eigen::Vector2d(2 * x[0] - 3 * x[1] + 1, 0.5 * x[0] + 4 * x[1] - 2); }},
   };
   for (const auto kind : {MappingKind::RbfThinPlateSpline, MappingKind::RbfWendlandC2}) {
@@ -308,8 +309,8 @@ TEST(InterfaceMapRbf, SmoothFieldErrorAndOrder) {
     const Eigen::VectorXd exact = sample(fluid, u);
     for (auto& row : rows) {
       const fsi::coupling::InterfaceMap map(solid, fluid, row.m);
-      row.err[level] = (map.to_fluid(sample(solid, u)) - exact).lpNorm<Eigen::Infinity>() /
-                       exact.lpNorm<Eigen::Infinity>();
+      row.err[level] =
+          (map.to_fluid(sample(solid, u)) - exact).lpNorm<Eigen::Infinity>() / exact.lpNorm<Eigen::Infinity>();
     }
   }
   for (const auto& row : rows) {

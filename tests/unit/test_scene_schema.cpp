@@ -11,8 +11,8 @@
 namespace {
 
 // The sections a program knows are the ones it declares (the launcher: all of them).
-const bool kDeclared = (fsi::coupling::coupling_section(), fsi::models::solid_section(), fsi::models::fluid_section(),
-                        true);
+const bool kDeclared =
+    (fsi::coupling::coupling_section(), fsi::models::solid_section(), fsi::models::fluid_section(), true);
 
 std::vector<std::string> problems(const std::string& text, const std::vector<std::string>& overrides = {}) {
   std::vector<std::string> out;
@@ -127,9 +127,8 @@ TEST(SceneSchema, EveryKeyOfTheSchemaIsReadByItsModel) {
       "  output_every: 1\n";
   // The fem solid in place of the sdof one (the schema checks `solid`).
   std::string fem = text.substr(text.find("fem:\n") + 5);
-  std::string as_solid = text.substr(0, text.find("solid:")) + "solid:\n" + fem + text.substr(text.find("fluid:"),
-                                                                                                  text.find("fem:") -
-                                                                                                      text.find("fluid:"));
+  std::string as_solid = text.substr(0, text.find("solid:")) + "solid:\n" + fem +
+                         text.substr(text.find("fluid:"), text.find("fem:") - text.find("fluid:"));
   for (const auto& scene_text : {text.substr(0, text.find("fem:")), as_solid}) {
     const auto scene = fsi::Scene::parse(scene_text, "all.yaml");
     const auto r = fsi::schema::check_scene(scene);

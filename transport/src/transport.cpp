@@ -42,9 +42,7 @@ int poll_items(zmq::pollitem_t* items, std::size_t n, std::chrono::milliseconds 
 // `public-key = "..."` / `secret-key = "..."` of a ZPL certificate.
 std::string cert_value(const std::string& file, const std::string& key) {
   std::ifstream in(file);
-  if (!in)
-    throw TransportError("cannot read CURVE certificate '" + file +
-                         "' (make the folder with `fsi keys DIR`)");
+  if (!in) throw TransportError("cannot read CURVE certificate '" + file + "' (make the folder with `fsi keys DIR`)");
   const std::regex line("^\\s*" + key + "\\s*=\\s*\"([^\"]{40})\"\\s*$");
   for (std::string l; std::getline(in, l);) {
     std::smatch m;
@@ -53,12 +51,10 @@ std::string cert_value(const std::string& file, const std::string& key) {
   throw TransportError("CURVE certificate '" + file + "' has no " + key + " (40 Z85 characters)");
 }
 
-void write_cert(const std::string& file, const std::string& public_key,
-                const std::string& secret_key) {
+void write_cert(const std::string& file, const std::string& public_key, const std::string& secret_key) {
   std::ofstream out(file);
   if (!out) throw TransportError("cannot write '" + file + "'");
-  out << "#   ZeroMQ CURVE " << (secret_key.empty() ? "Public" : "**Secret**")
-      << " Certificate (fsi keys)\n"
+  out << "#   ZeroMQ CURVE " << (secret_key.empty() ? "Public" : "**Secret**") << " Certificate (fsi keys)\n"
       << "#   "
       << (secret_key.empty() ? "Give this file to the peers that must accept this side."
                              : "Keep this file private: it proves this side's identity.")
@@ -71,8 +67,7 @@ void write_cert(const std::string& file, const std::string& public_key,
 CurveKeys load_curve_keys(const std::string& folder, const std::string& side) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(folder))
-    throw TransportError("--curve-keys '" + folder +
-                         "' is not a folder (make one with `fsi keys DIR`)");
+    throw TransportError("--curve-keys '" + folder + "' is not a folder (make one with `fsi keys DIR`)");
   CurveKeys k;
   k.folder = folder;
   const std::string secret = (fs::path(folder) / (side + ".key_secret")).string();
@@ -127,8 +122,7 @@ Client::Client(const std::string& endpoint, std::string peer_name, const CurveKe
     const std::string mon = "inproc://fsi-client-monitor-" + std::to_string(monitor_counter++);
     if (zmq_socket_monitor(impl_->socket.handle(), mon.c_str(),
                            ZMQ_EVENT_DISCONNECTED | ZMQ_EVENT_HANDSHAKE_FAILED_AUTH |
-                               ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
-                               ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) == 0) {
+                               ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL | ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) == 0) {
       impl_->monitor = zmq::socket_t(context(), zmq::socket_type::pair);
       impl_->monitor.set(zmq::sockopt::linger, 0);
       impl_->monitor.connect(mon);
@@ -166,14 +160,13 @@ void Client::send(const std::string& payload, std::chrono::milliseconds timeout)
 std::string Client::receive(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (true) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0)
       throw TimeoutError("no reply from " + peer_name_ + " at " + endpoint_ + " within " +
                          std::to_string(timeout.count()) + " ms");
-    zmq::pollitem_t items[2] = {
-        {impl_->socket.handle(), 0, ZMQ_POLLIN, 0},
-        {impl_->have_monitor ? impl_->monitor.handle() : nullptr, 0, ZMQ_POLLIN, 0}};
+    zmq::pollitem_t items[2] = {{impl_->socket.handle(), 0, ZMQ_POLLIN, 0},
+                                {impl_->have_monitor ? impl_->monitor.handle() : nullptr, 0, ZMQ_POLLIN, 0}};
     poll_items(items, impl_->have_monitor ? 2 : 1, left);
     if (items[0].revents & ZMQ_POLLIN) {
       std::vector<zmq::message_t> frames;
@@ -197,19 +190,17 @@ std::string Client::receive(std::chrono::milliseconds timeout) {
       if (id == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH || id == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL ||
           id == ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) {
         impl_->lost = true;
-        throw TransportError(
-            peer_name_ + " at " + endpoint_ + " refused the connection: " +
-            (impl_->curve_folder.empty()
-                 ? std::string("it requires CURVE authentication (--curve-keys)")
-                 : "CURVE authentication failed with the keys of " + impl_->curve_folder +
-                       " (not the server's keys, or this client's key is not authorised)"));
+        throw TransportError(peer_name_ + " at " + endpoint_ + " refused the connection: " +
+                             (impl_->curve_folder.empty()
+                                  ? std::string("it requires CURVE authentication (--curve-keys)")
+                                  : "CURVE authentication failed with the keys of " + impl_->curve_folder +
+                                        " (not the server's keys, or this client's key is not authorised)"));
       }
       if (id == ZMQ_EVENT_DISCONNECTED) {
         // A peer that replies and exits at once (Stop) may disconnect before its reply is
         // delivered to this socket: give the reply a short grace period.
         zmq::pollitem_t last{impl_->socket.handle(), 0, ZMQ_POLLIN, 0};
-        if (poll_items(&last, 1, std::chrono::milliseconds(100)) > 0 && (last.revents & ZMQ_POLLIN))
-          continue;
+        if (poll_items(&last, 1, std::chrono::milliseconds(100)) > 0 && (last.revents & ZMQ_POLLIN)) continue;
         impl_->lost = true;
         throw PeerLostError(peer_name_ + " at " + endpoint_ +
                             " closed the connection while a reply was awaited (process died?)");
@@ -226,16 +217,14 @@ struct Server::Impl {
   zmq::socket_t socket{context(), zmq::socket_type::router};
   zmq::socket_t monitor;
   bool have_monitor = false;
-  std::map<int, std::string>
-      peer_of_fd;  // the connection (file descriptor) a peer's requests came on
+  std::map<int, std::string> peer_of_fd;  // the connection (file descriptor) a peer's requests came on
   ~Impl() {
     zap_stop = true;
     if (zap.joinable()) zap.join();
   }
 };
 
-Server::Server(const std::string& endpoint, const CurveKeys& keys)
-    : impl_(std::make_unique<Impl>()) {
+Server::Server(const std::string& endpoint, const CurveKeys& keys) : impl_(std::make_unique<Impl>()) {
   try {
     impl_->socket.set(zmq::sockopt::linger, 1000);
     if (keys.enabled()) {
@@ -245,8 +234,7 @@ Server::Server(const std::string& endpoint, const CurveKeys& keys)
       std::vector<std::string> authorized;
       for (const auto& k : keys.authorized) {
         std::string raw(32, '\0');
-        if (zmq_z85_decode(reinterpret_cast<std::uint8_t*>(raw.data()), k.c_str()))
-          authorized.push_back(raw);
+        if (zmq_z85_decode(reinterpret_cast<std::uint8_t*>(raw.data()), k.c_str())) authorized.push_back(raw);
       }
       impl_->zap = std::thread([zap, authorized, stop = &impl_->zap_stop] {
         try {
@@ -262,18 +250,14 @@ Server::Server(const std::string& endpoint, const CurveKeys& keys)
               if (!more) break;
             }
             auto text = [&](std::size_t i) {
-              return i < f.size() ? std::string(static_cast<const char*>(f[i].data()), f[i].size())
-                                  : std::string();
+              return i < f.size() ? std::string(static_cast<const char*>(f[i].data()), f[i].size()) : std::string();
             };
-            const bool ok =
-                text(5) == "CURVE" && f.size() > 6 &&
-                std::find(authorized.begin(), authorized.end(), text(6)) != authorized.end();
+            const bool ok = text(5) == "CURVE" && f.size() > 6 &&
+                            std::find(authorized.begin(), authorized.end(), text(6)) != authorized.end();
             const std::vector<std::string> reply{
-                "1.0", text(1), ok ? "200" : "400", ok ? "OK" : "client key not authorised",
-                "",    ""};
+                "1.0", text(1), ok ? "200" : "400", ok ? "OK" : "client key not authorised", "", ""};
             for (std::size_t i = 0; i < reply.size(); ++i)
-              zap->send(zmq::buffer(reply[i]),
-                        i + 1 < reply.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+              zap->send(zmq::buffer(reply[i]), i + 1 < reply.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
           }
         } catch (const zmq::error_t&) {
           // the context is going away: no more connections to authenticate
@@ -338,9 +322,7 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     if (should_stop && should_stop()) return true;
     drain_disconnects(std::chrono::milliseconds(0));
     if (!(item.revents & ZMQ_POLLIN)) {
-      if (idle_timeout.count() > 0 &&
-          std::chrono::steady_clock::now() - last_activity > idle_timeout)
-        return false;
+      if (idle_timeout.count() > 0 && std::chrono::steady_clock::now() - last_activity > idle_timeout) return false;
       continue;
     }
     std::vector<zmq::message_t> frames;
@@ -379,8 +361,7 @@ bool Server::serve(const Handler& handler, std::chrono::milliseconds idle_timeou
     std::string reply;
     if (payload_frames == 1) {
       const auto& payload = frames[envelope];
-      reply = handler(std::string(static_cast<const char*>(payload.data()), payload.size()), peer,
-                      stop);
+      reply = handler(std::string(static_cast<const char*>(payload.data()), payload.size()), peer, stop);
     } else if (frame_error_) {
       reply = frame_error_(payload_frames);
     } else {

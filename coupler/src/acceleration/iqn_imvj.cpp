@@ -47,9 +47,9 @@ class IqnImvj : public QuasiNewton {
   std::vector<Factors> chunk_;  // restart modes: the updates since the last restart
   int steps_in_chunk_ = 0;
   std::deque<std::deque<Eigen::VectorXd>> v_restart_, w_restart_;  // rs-ls: the last steps' pairs
-  Eigen::MatrixXd psi_, phi_;   // rs-svd: J_svd = psi diag(sigma) phi^T
+  Eigen::MatrixXd psi_, phi_;                                      // rs-svd: J_svd = psi diag(sigma) phi^T
   Eigen::VectorXd sigma_;
-  Factors last_;                // the step's update at its last iteration
+  Factors last_;  // the step's update at its last iteration
   bool last_valid_ = false;
 };
 
@@ -60,7 +60,8 @@ Eigen::MatrixXd IqnImvj::columns_of(const std::vector<const Eigen::VectorXd*>& c
 }
 
 Eigen::MatrixXd IqnImvj::apply_prior(const Eigen::MatrixXd& y) const {
-  Eigen::MatrixXd out = jacobian_.size() > 0 ? Eigen::MatrixXd(jacobian_ * y) : Eigen::MatrixXd::Zero(y.rows(), y.cols());
+  Eigen::MatrixXd out =
+      jacobian_.size() > 0 ? Eigen::MatrixXd(jacobian_ * y) : Eigen::MatrixXd::Zero(y.rows(), y.cols());
   for (const auto& f : chunk_) out += f.wtil * (f.z * y);
   if (sigma_.size() > 0) out += psi_ * (sigma_.asDiagonal() * (phi_.transpose() * y));
   return out;
@@ -93,8 +94,10 @@ void IqnImvj::end_step() {
   QuasiNewton::end_step();
   if (settings_.imvj_restart == ImvjRestart::None) {
     if (last_valid_) {
-      if (jacobian_.size() == 0) jacobian_ = last_.wtil * last_.z;
-      else jacobian_.noalias() += last_.wtil * last_.z;
+      if (jacobian_.size() == 0)
+        jacobian_ = last_.wtil * last_.z;
+      else
+        jacobian_.noalias() += last_.wtil * last_.z;
     }
   } else {
     if (last_valid_) chunk_.push_back(last_);
@@ -122,7 +125,8 @@ void IqnImvj::restart() {
   if (settings_.imvj_restart != ImvjRestart::LeastSquares) return;
   std::vector<const Eigen::VectorXd*> v, w;
   for (std::size_t s = 0; s < v_restart_.size(); ++s)
-    for (std::size_t i = 0; i < v_restart_[s].size(); ++i) v.push_back(&v_restart_[s][i]), w.push_back(&w_restart_[s][i]);
+    for (std::size_t i = 0; i < v_restart_[s].size(); ++i)
+      v.push_back(&v_restart_[s][i]), w.push_back(&w_restart_[s][i]);
   if (v.empty()) return;
   const Columns c = filter_columns(v, w, v.front()->size());
   if (c.m > 0) chunk_.push_back({columns_of(c.w, c.m), pseudo_inverse(c)});

@@ -1,7 +1,6 @@
 #include "quasi_newton.hpp"
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <cmath>
 

@@ -5,7 +5,6 @@
 // residual-sum preconditioner, and their place in checkpoints. A scheme says what its update
 // does with them (quasi_newton_update).
 #include <Eigen/Core>
-
 #include <deque>
 #include <vector>
 
@@ -60,7 +59,7 @@ class QuasiNewton : public Accelerator {
   bool qr3_insert(Eigen::Index n);  // the new column into columns_; false: qr2 is needed
   void update_preconditioner(const Eigen::VectorXd& r);
 
-  Columns columns_;           // the last filtered_columns() result (qr3 updates it)
+  Columns columns_;             // the last filtered_columns() result (qr3 updates it)
   bool columns_valid_ = false;  // columns_ belongs to this step's columns but the newest
   // residual-sum preconditioner: the weights of the force components (x, y) and this step's
   // sums of their shares of the residual norm.

@@ -1,14 +1,13 @@
 #include "fsi/fluid/field_transfer.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/LU>
-
-#include "fsi/fluid/p2p1_element.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include <fmt/format.h>
+#include "fsi/fluid/p2p1_element.hpp"
 
 namespace fsi::fluid {
 
@@ -26,8 +25,8 @@ void p2(double xi, double eta, double N[6], double dxi[6], double deta[6]) {
 
 MeshLocator::MeshLocator(const FluidMesh& mesh, const Eigen::MatrixX2d& positions) : mesh_(mesh), x_(positions) {
   if (positions.rows() != mesh.node_count())
-    throw std::invalid_argument(fmt::format("field transfer: {} positions for a mesh of {} nodes", positions.rows(),
-                                            mesh.node_count()));
+    throw std::invalid_argument(
+        fmt::format("field transfer: {} positions for a mesh of {} nodes", positions.rows(), mesh.node_count()));
   const int nt = std::max(mesh.triangle_count(), 1);
   lo_ = x_.colwise().minCoeff().transpose();
   const Eigen::Vector2d hi = x_.colwise().maxCoeff().transpose();
@@ -75,7 +74,8 @@ PointLocation MeshLocator::in_triangle(int e, const Eigen::Vector2d& p) const {
     double N[6], a[6], b[6];
     p2(s(0), s(1), N, a, b);
     Eigen::Vector2d x = Eigen::Vector2d::Zero(), dx = x, dy = x;
-    for (int k = 0; k < 6; ++k) x += N[k] * xe.row(k).transpose(), dx += a[k] * xe.row(k).transpose(), dy += b[k] * xe.row(k).transpose();
+    for (int k = 0; k < 6; ++k)
+      x += N[k] * xe.row(k).transpose(), dx += a[k] * xe.row(k).transpose(), dy += b[k] * xe.row(k).transpose();
     if (jac) *jac << dx, dy;
     return x;
   };

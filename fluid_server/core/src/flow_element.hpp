@@ -14,7 +14,6 @@
 // the P2 nodal pressure and in the vertex-driven mesh motion, by FluidMesh::interpolate_midpoints.)
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <array>
 #include <map>
 #include <memory>
@@ -43,7 +42,7 @@ struct AssemblyInput {
   const Eigen::VectorXd& U_lin;           // linearisation velocity u* (every unknown)
   const Eigen::VectorXd& history;         // (alpha1 u_n + alpha2 u_{n-1}) / dt (every unknown; 0 if steady)
   const FlowParameters& params;
-  double alpha0_dt = 0, dt = 0;           // 0 if steady
+  double alpha0_dt = 0, dt = 0;  // 0 if steady
 };
 
 // The local matrix and right-hand side of a triangle or an interface edge, in the element's
@@ -76,8 +75,8 @@ class FlowElement {
   virtual const char* name() const = 0;  // fluid.element: "p1p1", "p2p1" (checkpoints)
   virtual const FluidMesh& mesh() const = 0;
   virtual DofLayout layout() const = 0;
-  virtual int local_size() const = 0;                         // unknowns per triangle
-  virtual void element_dofs(int e, int* dofs) const = 0;      // local_size() global unknowns
+  virtual int local_size() const = 0;                     // unknowns per triangle
+  virtual void element_dofs(int e, int* dofs) const = 0;  // local_size() global unknowns
   // Halve a Newton update that grows the change (iterations 3 on)? P2/P1 yes; P1/P1 no (its
   // Newton, the Galerkin Jacobian with Picard stabilisation terms, has always run undamped).
   virtual bool damped_newton() const = 0;

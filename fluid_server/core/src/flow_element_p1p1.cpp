@@ -4,8 +4,8 @@
 
 #include <stdexcept>
 
-#include "fsi/fluid/p1_element.hpp"
 #include "flow_element.hpp"
+#include "fsi/fluid/p1_element.hpp"
 
 namespace fsi::fluid::detail {
 namespace {
@@ -52,8 +52,9 @@ class P1P1Element final : public FlowElement {
  public:
   explicit P1P1Element(FluidMesh mesh) : mesh_(std::move(mesh)) {
     if (mesh_.quadratic())
-      throw std::invalid_argument("the P1/P1 fluid needs a mesh of 3-node triangles (this one has 6-node triangles: "
-                                  "use fluid.element: p2p1, or mesh with -order 1)");
+      throw std::invalid_argument(
+          "the P1/P1 fluid needs a mesh of 3-node triangles (this one has 6-node triangles: "
+          "use fluid.element: p2p1, or mesh with -order 1)");
   }
   const char* name() const override { return "p1p1"; }
   const FluidMesh& mesh() const override { return mesh_; }
@@ -103,9 +104,7 @@ class P1P1Element final : public FlowElement {
     return true;
   }
   const char* cell_name() const override { return "element"; }
-  std::string inverted(double area) const override {
-    return fmt::format("inverted or degenerate (area {:.3g})", area);
-  }
+  std::string inverted(double area) const override { return fmt::format("inverted or degenerate (area {:.3g})", area); }
 
   InterfaceEdge interface_edge(int e, int k, int a, int b, const std::map<int, int>& iface,
                                std::vector<std::array<int, 2>>& segments) const override {
@@ -135,7 +134,7 @@ class P1P1Element final : public FlowElement {
     normal /= length;
     const int third = 3 - la - lb;
     if (normal.dot(x.row(third).transpose() - xa) > 0) normal = -normal;  // outward of the fluid
-    Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();  // int_seg N_i N_j
+    Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();                       // int_seg N_i N_j
     Eigen::Vector3d integral = Eigen::Vector3d::Zero();
     mass(la, la) = mass(lb, lb) = length / 3.0;
     mass(la, lb) = mass(lb, la) = length / 6.0;
@@ -143,7 +142,8 @@ class P1P1Element final : public FlowElement {
     // The penalty term's mass: on this interface, or on the last accepted step's.
     Eigen::Matrix3d penalty_mass = mass;
     if (in.params.penalty_on_step_start) {
-      const double ln = (in.X_n.row(mesh_.triangles(s.element, lb)) - in.X_n.row(mesh_.triangles(s.element, la))).norm();
+      const double ln =
+          (in.X_n.row(mesh_.triangles(s.element, lb)) - in.X_n.row(mesh_.triangles(s.element, la))).norm();
       penalty_mass = mass * (ln / length);
     }
     const Eigen::Vector3d gn = geo.grad * normal;  // grad N_i . n
@@ -197,6 +197,8 @@ class P1P1Element final : public FlowElement {
 
 }  // namespace
 
-std::unique_ptr<FlowElement> make_p1p1_element(FluidMesh mesh) { return std::make_unique<P1P1Element>(std::move(mesh)); }
+std::unique_ptr<FlowElement> make_p1p1_element(FluidMesh mesh) {
+  return std::make_unique<P1P1Element>(std::move(mesh));
+}
 
 }  // namespace fsi::fluid::detail

@@ -2,13 +2,13 @@
 // triangles, (u, v) of every node at 2 i, 2 i + 1, then p of the vertices (2 n + i); P2
 // traces on the interface edges (4-point Gauss), every edge split at its midpoint for the
 // coupler.
-#include <Eigen/LU>
 #include <fmt/format.h>
 
+#include <Eigen/LU>
 #include <stdexcept>
 
-#include "fsi/fluid/p2p1_element.hpp"
 #include "flow_element.hpp"
+#include "fsi/fluid/p2p1_element.hpp"
 
 namespace fsi::fluid::detail {
 namespace {
@@ -55,8 +55,9 @@ void add_nitsche_point(const EdgePoint& p, double w, double w_pen, const Eigen::
   for (int i = 0; i < 6; ++i) {
     for (int j = 0; j < 6; ++j) {
       // (the default's arithmetic exactly as before the penalty_geometry option)
-      const double vel = step_start ? w_pen * g1 * p.N(i) * p.N(j) + w * (-mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j))
-                                    : w * (g1 * p.N(i) * p.N(j) - mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j));
+      const double vel = step_start
+                             ? w_pen * g1 * p.N(i) * p.N(j) + w * (-mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j))
+                             : w * (g1 * p.N(i) * p.N(j) - mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j));
       for (int c = 0; c < 2; ++c) out.matrix(2 * i + c, 2 * j + c) += vel;
     }
     for (int j = 0; j < 3; ++j)
@@ -65,8 +66,8 @@ void add_nitsche_point(const EdgePoint& p, double w, double w_pen, const Eigen::
         out.matrix(12 + j, 2 * i + c) += w * g2 * p.L(j) * p.normal(c) * p.N(i);
       }
     for (int c = 0; c < 2; ++c)
-      out.rhs(2 * i + c) += step_start ? (w_pen * g1 * p.N(i) - w * g2 * mu * gn(i)) * v(c)
-                                       : w * (g1 * p.N(i) - g2 * mu * gn(i)) * v(c);
+      out.rhs(2 * i + c) +=
+          step_start ? (w_pen * g1 * p.N(i) - w * g2 * mu * gn(i)) * v(c) : w * (g1 * p.N(i) - g2 * mu * gn(i)) * v(c);
   }
   for (int j = 0; j < 3; ++j) out.rhs(12 + j) += w * g2 * p.L(j) * v.dot(p.normal.transpose());
 }
@@ -79,9 +80,10 @@ class P2P1Element final : public FlowElement {
       const auto x = element_positions(mesh_.nodes, e);
       if (!(p2_min_jacobian(x) > 0)) {
         const Eigen::RowVector2d c = (x.row(0) + x.row(1) + x.row(2)) / 3.0;
-        throw std::invalid_argument(fmt::format("fluid mesh: 6-node triangle {} near ({:.5g}, {:.5g}) is inverted or "
-                                                "too strongly curved (det J <= 0 inside)",
-                                                e, c(0), c(1)));
+        throw std::invalid_argument(
+            fmt::format("fluid mesh: 6-node triangle {} near ({:.5g}, {:.5g}) is inverted or "
+                        "too strongly curved (det J <= 0 inside)",
+                        e, c(0), c(1)));
       }
     }
   }
@@ -173,8 +175,7 @@ class P2P1Element final : public FlowElement {
     for (int g = 0; g < 4; ++g) {
       const auto p = edge_point(x, edge.edge, kGaussX[g]);
       for (std::size_t i = 0; i < 3; ++i)
-        for (std::size_t j = 0; j < 3; ++j)
-          m(i, j) += kGaussW[g] * p.ds * p.N(edge.local[i]) * p.N(edge.local[j]);
+        for (std::size_t j = 0; j < 3; ++j) m(i, j) += kGaussW[g] * p.ds * p.N(edge.local[i]) * p.N(edge.local[j]);
     }
     for (std::size_t i = 0; i < 3; ++i)
       for (std::size_t j = 0; j < 3; ++j) t.emplace_back(edge.iface[i], edge.iface[j], m(i, j));
@@ -210,6 +211,8 @@ class P2P1Element final : public FlowElement {
 
 }  // namespace
 
-std::unique_ptr<FlowElement> make_p2p1_element(FluidMesh mesh) { return std::make_unique<P2P1Element>(std::move(mesh)); }
+std::unique_ptr<FlowElement> make_p2p1_element(FluidMesh mesh) {
+  return std::make_unique<P2P1Element>(std::move(mesh));
+}
 
 }  // namespace fsi::fluid::detail

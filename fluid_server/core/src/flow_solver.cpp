@@ -3,9 +3,9 @@
 // flow_element_p1p1.cpp and flow_element_p2p1.cpp (flow_element.hpp).
 #include "fsi/fluid/flow_solver.hpp"
 
-#include <Eigen/LU>
 #include <fmt/format.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,10 +13,10 @@
 #include <map>
 #include <stdexcept>
 
+#include "flow_element.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/field_transfer.hpp"
 #include "fsi/fluid/sparse_lu.hpp"
-#include "flow_element.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -142,9 +142,9 @@ std::unique_ptr<detail::FlowElement> make_element(const std::string& name, Fluid
 struct FlowSolver::Impl {
   std::unique_ptr<detail::FlowElement> element;
   detail::DofLayout dof;
-  int local = 0;                     // unknowns per triangle
-  std::vector<int> element_dofs;     // per triangle its `local` unknowns
-  std::vector<int> scatter;          // per triangle local x local positions in valuePtr (column-major local)
+  int local = 0;                               // unknowns per triangle
+  std::vector<int> element_dofs;               // per triangle its `local` unknowns
+  std::vector<int> scatter;                    // per triangle local x local positions in valuePtr (column-major local)
   Eigen::SparseMatrix<double> matrix, volume;  // the system (constraints applied); the volume terms (reactions)
   Eigen::VectorXd rhs, rhs_volume;
   std::unique_ptr<SparseLu> lu;
@@ -157,7 +157,9 @@ struct FlowSolver::Impl {
   std::vector<std::vector<double>> thread_values;
 
   const FluidMesh& mesh() const { return element->mesh(); }
-  const int* dofs_of(int e) const { return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)]; }
+  const int* dofs_of(int e) const {
+    return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)];
+  }
   const int* scatter_of(int e) const {
     return &scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local)];
   }
@@ -207,7 +209,8 @@ void FlowSolver::Impl::build_pattern() {
       const auto& list = rows[static_cast<std::size_t>(d[j])];
       for (int i = 0; i < local; ++i) {
         const auto it = std::lower_bound(list.begin(), list.end(), d[i]);
-        scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local) + static_cast<std::size_t>(local * j + i)] =
+        scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local) +
+                static_cast<std::size_t>(local * j + i)] =
             matrix.outerIndexPtr()[d[j]] + static_cast<int>(it - list.begin());
       }
     }
@@ -260,13 +263,13 @@ int FlowSolver::Impl::assemble_volume(const detail::AssemblyInput& in, int nthre
 
 // Everything a solve of one time level fixes before its iterations.
 struct FlowSolver::Step {
-  double time = 0, dt = 0;       // dt: 0 if steady
-  double alpha0_dt = 0;          // alpha0 / dt (0 if steady)
+  double time = 0, dt = 0;  // dt: 0 if steady
+  double alpha0_dt = 0;     // alpha0 / dt (0 if steady)
   Eigen::MatrixX2d mesh_velocity, body;
-  Eigen::VectorXd U_lin;         // linearisation velocity of the first iteration
-  Eigen::VectorXd history;       // (alpha1 u_n + alpha2 u_{n-1}) / dt
+  Eigen::VectorXd U_lin;    // linearisation velocity of the first iteration
+  Eigen::VectorXd history;  // (alpha1 u_n + alpha2 u_{n-1}) / dt
   StrongConstraints constraints;
-  bool retrial = false;          // a repeated solve of the time level: start from its last solution
+  bool retrial = false;  // a repeated solve of the time level: start from its last solution
 };
 
 FlowSolver::FlowSolver(FluidMesh mesh, FlowParameters params, const std::string& element)
@@ -317,12 +320,14 @@ void FlowSolver::set_interface(const std::vector<std::string>& groups) {
       const int a = seg(s, 0), b = seg(s, 1);
       const auto it = edge_owner.find({std::min(a, b), std::max(a, b)});
       if (it == edge_owner.end())
-        throw std::runtime_error(fmt::format("interface group '{}': segment ({}, {}) is not a triangle edge", name, a, b));
+        throw std::runtime_error(
+            fmt::format("interface group '{}': segment ({}, {}) is not a triangle edge", name, a, b));
       impl_->edges.push_back(impl_->element->interface_edge(it->second.first, it->second.second, a, b, local, segs));
     }
   }
   interface_segments_.resize(static_cast<Eigen::Index>(segs.size()), 2);
-  for (std::size_t s = 0; s < segs.size(); ++s) interface_segments_.row(static_cast<Eigen::Index>(s)) << segs[s][0], segs[s][1];
+  for (std::size_t s = 0; s < segs.size(); ++s)
+    interface_segments_.row(static_cast<Eigen::Index>(s)) << segs[s][0], segs[s][1];
   interface_velocity_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
 }
 
@@ -350,11 +355,13 @@ FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::Mat
   if (positions.rows() != n) throw std::invalid_argument("FlowSolver::solve: positions has the wrong size");
   X_ = positions;
   dt_trial_ = dt;
-  if (interface_velocity.size() == 0) interface_velocity_.setZero();
+  if (interface_velocity.size() == 0)
+    interface_velocity_.setZero();
   else if (interface_velocity.size() != 2 * static_cast<Eigen::Index>(interface_nodes_.size()))
     throw std::invalid_argument(fmt::format("interface velocity has {} entries, expected {}", interface_velocity.size(),
                                             2 * interface_nodes_.size()));
-  else interface_velocity_ = interface_velocity;
+  else
+    interface_velocity_ = interface_velocity;
 
   Step s;
   s.time = time;
@@ -388,15 +395,18 @@ FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::Mat
 void FlowSolver::assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report) {
   auto& im = *impl_;
   const auto t_assembly = Clock::now();
-  const detail::AssemblyInput in{X_, step.mesh_velocity, step.body, U_lin, step.history, params_, step.alpha0_dt, step.dt};
+  const detail::AssemblyInput in{X_,      step.mesh_velocity, step.body, U_lin, step.history,
+                                 params_, step.alpha0_dt,     step.dt};
   im.element->prepare(in);
   double bad = 0;
   if (const int e = im.assemble_volume(in, std::max(1, params_.threads), bad); e >= 0) {
     const auto& m = mesh();
-    const Eigen::RowVector2d centre = (X_.row(m.triangles(e, 0)) + X_.row(m.triangles(e, 1)) + X_.row(m.triangles(e, 2))) / 3.0;
-    throw SolverError(fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}) is {}; the mesh motion "
-                                  "tangled the mesh",
-                                  step.time, im.element->cell_name(), e, centre(0), centre(1), im.element->inverted(bad)));
+    const Eigen::RowVector2d centre =
+        (X_.row(m.triangles(e, 0)) + X_.row(m.triangles(e, 1)) + X_.row(m.triangles(e, 2))) / 3.0;
+    throw SolverError(
+        fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}) is {}; the mesh motion "
+                    "tangled the mesh",
+                    step.time, im.element->cell_name(), e, centre(0), centre(1), im.element->inverted(bad)));
   }
   std::copy(im.volume.valuePtr(), im.volume.valuePtr() + im.volume.nonZeros(), im.matrix.valuePtr());
   im.rhs = im.rhs_volume;
@@ -420,9 +430,9 @@ StepReport FlowSolver::solve(double time, double dt, const Eigen::MatrixX2d& pos
   double previous_change = std::numeric_limits<double>::infinity();
   for (int iteration = 1; iteration <= std::max(1, params_.max_iterations); ++iteration) {
     assemble(step, U_lin, report);
-    Eigen::VectorXd U_new = im.lu->solve(im.matrix, im.rhs, step.retrial ? U_ : U_lin, report,
-                                         fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration),
-                                         step.alpha0_dt);
+    Eigen::VectorXd U_new =
+        im.lu->solve(im.matrix, im.rhs, step.retrial ? U_ : U_lin, report,
+                     fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration), step.alpha0_dt);
     double change = relative_velocity_change(U_new, U_lin, mesh().node_count(), im.dof);
     // Damped Newton (P2/P1): an update that grows the change is halved (iterations 3 on, so
     // the first Oseen/Stokes solve and the first Newton correction are always taken whole).
@@ -478,8 +488,8 @@ void FlowSolver::save_state(StateArchive& state, const std::string& prefix) {
 void FlowSolver::load_state(const StateArchive& state, const std::string& prefix) {
   const std::string element = impl_->element->name(), saved = state.text(prefix + "element");
   if (saved != element)
-    throw StateError(fmt::format("entry '{}element' is '{}', this configuration uses fluid.element {}", prefix, saved,
-                                 element));
+    throw StateError(
+        fmt::format("entry '{}element' is '{}', this configuration uses fluid.element {}", prefix, saved, element));
   const Eigen::Index ndof = U_.size(), npos = X_.size();
   Eigen::VectorXd U = state.vector(prefix + "u", ndof), U_n = state.vector(prefix + "u_n", ndof),
                   U_nm1 = state.vector(prefix + "u_nm1", ndof), reaction = state.vector(prefix + "reaction", ndof);
@@ -541,7 +551,8 @@ TransferReport FlowSolver::transfer_state(const FlowSolver& old, const std::vect
       U_n_(nd.velocity(i, c)) = at_nodes(i, c);
       U_nm1_(nd.velocity(i, c)) = at_nodes(i, 2 + c);
     }
-  for (int v = 0; v < nm.vertices(); ++v) U_n_(nd.pressure(v)) = at_vertices(v, 0), U_nm1_(nd.pressure(v)) = at_vertices(v, 1);
+  for (int v = 0; v < nm.vertices(); ++v)
+    U_n_(nd.pressure(v)) = at_vertices(v, 0), U_nm1_(nd.pressure(v)) = at_vertices(v, 1);
   U_ = U_n_;
   reaction_ = Eigen::VectorXd::Zero(nd.dofs);
   X_ = X_n_ = nm.nodes;
@@ -564,7 +575,8 @@ void FlowSolver::restart_history() {
 
 Eigen::MatrixX2d FlowSolver::velocity() const {
   Eigen::MatrixX2d v(mesh().node_count(), 2);
-  for (int i = 0; i < mesh().node_count(); ++i) v.row(i) << U_(impl_->dof.velocity(i, 0)), U_(impl_->dof.velocity(i, 1));
+  for (int i = 0; i < mesh().node_count(); ++i)
+    v.row(i) << U_(impl_->dof.velocity(i, 0)), U_(impl_->dof.velocity(i, 1));
   return v;
 }
 
@@ -600,7 +612,8 @@ Eigen::VectorXd FlowSolver::interface_traction() const {
   for (Eigen::Index i = 0; i < ni; ++i)
     f.segment<2>(2 * i) = reaction_.segment<2>(impl_->dof.velocity(interface_nodes_[static_cast<std::size_t>(i)], 0));
   // + gamma_N1 int N^T (v_f - v_s) = gamma_N1 (f_v - M_f v_s)
-  return f + params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));
+  return f +
+         params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));
 }
 
 // The vertex triangle holding `point` (at the positions of the last solve), with barycentric

@@ -13,8 +13,8 @@ const IndexMatrix2& FluidMesh::boundary(const std::string& name) const {
   if (it != boundaries.end()) return it->second;
   std::string known;
   for (const auto& [n, _] : boundaries) known += (known.empty() ? "" : ", ") + n;
-  throw std::runtime_error(fmt::format("fluid mesh has no boundary group '{}' (groups: {})", name,
-                                       known.empty() ? "none" : known));
+  throw std::runtime_error(
+      fmt::format("fluid mesh has no boundary group '{}' (groups: {})", name, known.empty() ? "none" : known));
 }
 
 std::vector<int> FluidMesh::boundary_nodes(const std::vector<std::string>& names) const {
@@ -47,15 +47,18 @@ FluidMesh FluidMesh::from_gmsh(const GmshMesh& mesh, const std::vector<std::stri
     if (!domain_groups.empty() && std::find(domain_groups.begin(), domain_groups.end(), g.name) == domain_groups.end())
       continue;
     if (g.element_type != 2 && g.element_type != 9)
-      throw std::runtime_error(fmt::format("{}: group '{}' has gmsh element type {}; the fluid needs 3-node (P1/P1) "
-                                           "or 6-node (P2/P1) triangles (mesh without recombination)",
-                                           mesh.source.string(), g.name, g.element_type));
+      throw std::runtime_error(
+          fmt::format("{}: group '{}' has gmsh element type {}; the fluid needs 3-node (P1/P1) "
+                      "or 6-node (P2/P1) triangles (mesh without recombination)",
+                      mesh.source.string(), g.name, g.element_type));
     if (cell_type != 0 && g.element_type != cell_type)
-      throw std::runtime_error(fmt::format("{}: the fluid groups mix 3-node and 6-node triangles", mesh.source.string()));
+      throw std::runtime_error(
+          fmt::format("{}: the fluid groups mix 3-node and 6-node triangles", mesh.source.string()));
     cell_type = g.element_type;
     cells.push_back(&g);
   }
-  if (cells.empty()) throw std::runtime_error(fmt::format("{}: no 2D triangle group for the fluid", mesh.source.string()));
+  if (cells.empty())
+    throw std::runtime_error(fmt::format("{}: no 2D triangle group for the fluid", mesh.source.string()));
   const bool quad = cell_type == 9;
 
   std::vector<int> new_index(static_cast<std::size_t>(mesh.nodes.rows()), -1);
@@ -80,7 +83,8 @@ FluidMesh FluidMesh::from_gmsh(const GmshMesh& mesh, const std::vector<std::stri
   if (!quad) out.vertex_count = -1;
   out.nodes.resize(count, 2);
   for (Eigen::Index i = 0; i < mesh.nodes.rows(); ++i)
-    if (new_index[static_cast<std::size_t>(i)] >= 0) out.nodes.row(new_index[static_cast<std::size_t>(i)]) = mesh.nodes.row(i);
+    if (new_index[static_cast<std::size_t>(i)] >= 0)
+      out.nodes.row(new_index[static_cast<std::size_t>(i)]) = mesh.nodes.row(i);
   for (Eigen::Index e = 0; e < out.triangles.rows(); ++e) {
     const Eigen::Vector2d a = out.nodes.row(out.triangles(e, 0)), b = out.nodes.row(out.triangles(e, 1)),
                           c = out.nodes.row(out.triangles(e, 2));
@@ -95,10 +99,10 @@ FluidMesh FluidMesh::from_gmsh(const GmshMesh& mesh, const std::vector<std::stri
     if (g.dimension != 1) continue;
     const int expected = quad ? 8 : 1;
     if (g.element_type != expected)
-      throw std::runtime_error(fmt::format("{}: boundary group '{}' has gmsh element type {}; expected {} lines with {} "
-                                           "triangles",
-                                           mesh.source.string(), g.name, g.element_type, quad ? "3-node" : "2-node",
-                                           quad ? "6-node" : "3-node"));
+      throw std::runtime_error(fmt::format(
+          "{}: boundary group '{}' has gmsh element type {}; expected {} lines with {} "
+          "triangles",
+          mesh.source.string(), g.name, g.element_type, quad ? "3-node" : "2-node", quad ? "6-node" : "3-node"));
     IndexMatrix2 seg(g.elements.rows(), 2);
     Eigen::VectorXi mid(quad ? g.elements.rows() : 0);
     for (Eigen::Index e = 0; e < g.elements.rows(); ++e)
@@ -107,8 +111,10 @@ FluidMesh FluidMesh::from_gmsh(const GmshMesh& mesh, const std::vector<std::stri
         if (idx < 0)
           throw std::runtime_error(fmt::format("{}: boundary group '{}' has a node outside the fluid triangles",
                                                mesh.source.string(), g.name));
-        if (k < 2) seg(e, k) = idx;
-        else mid(e) = idx;
+        if (k < 2)
+          seg(e, k) = idx;
+        else
+          mid(e) = idx;
       }
     out.boundaries[g.name] = std::move(seg);
     if (quad) out.boundary_midpoints[g.name] = std::move(mid);
@@ -138,7 +144,8 @@ FluidMesh FluidMesh::quadratic_from_linear() const {
     for (Eigen::Index s = 0; s < seg.rows(); ++s) {
       const auto it = edge_index.find({std::min(seg(s, 0), seg(s, 1)), std::max(seg(s, 0), seg(s, 1))});
       if (it == edge_index.end())
-        throw std::runtime_error(fmt::format("boundary group '{}': segment ({}, {}) is not a triangle edge", name, seg(s, 0), seg(s, 1)));
+        throw std::runtime_error(
+            fmt::format("boundary group '{}': segment ({}, {}) is not a triangle edge", name, seg(s, 0), seg(s, 1)));
       mid(s) = it->second;
     }
     out.boundary_midpoints[name] = std::move(mid);
@@ -178,8 +185,7 @@ FluidMesh FluidMesh::rectangle(double x0, double x1, double y0, double y1, int n
   out.nodes.resize((nx + 1) * (ny + 1), 2);
   auto id = [nx](int i, int j) { return j * (nx + 1) + i; };
   for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i)
-      out.nodes.row(id(i, j)) << x0 + (x1 - x0) * i / nx, y0 + (y1 - y0) * j / ny;
+    for (int i = 0; i <= nx; ++i) out.nodes.row(id(i, j)) << x0 + (x1 - x0) * i / nx, y0 + (y1 - y0) * j / ny;
   out.triangles.resize(2 * nx * ny, 3);
   int t = 0;
   for (int j = 0; j < ny; ++j)

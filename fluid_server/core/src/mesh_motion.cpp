@@ -1,9 +1,9 @@
 #include "fsi/fluid/mesh_motion.hpp"
 
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 #include <fmt/format.h>
 
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -20,16 +20,16 @@ struct MeshMotion::Impl {
   const FluidMesh* mesh = nullptr;
   MeshMotionOptions options;
   int nodes = 0;
-  int comps = 1;                         // unknowns per node: 1 (harmonic, per component) or 2 (elastic)
+  int comps = 1;  // unknowns per node: 1 (harmonic, per component) or 2 (elastic)
   std::vector<int> moving;
-  std::vector<int> free_index;           // node -> free node index or -1 (prescribed)
+  std::vector<int> free_index;  // node -> free node index or -1 (prescribed)
   int nfree = 0;
   Eigen::SparseMatrix<double> coupling;  // free unknowns x prescribed unknowns (all nodes * comps)
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
   bool analysed = false;
   // Incremental state: the mesh of the last accepted step.
-  Eigen::MatrixX2d base_displacement;    // n x 2, from the reference
-  Eigen::VectorXd base_moving;           // moving nodes' displacement at the base
+  Eigen::MatrixX2d base_displacement;  // n x 2, from the reference
+  Eigen::VectorXd base_moving;         // moving nodes' displacement at the base
   double seconds = 0;
 
   void build(const Eigen::MatrixX2d& positions);
@@ -47,8 +47,10 @@ void MeshMotion::Impl::build(const Eigen::MatrixX2d& positions) {
     const double area = geo[static_cast<std::size_t>(e)].area;
     if (!(area > 0)) {
       const Eigen::Vector2d c = x.colwise().mean().transpose();
-      throw SolverError(fmt::format("mesh motion: element {} near ({:.5g}, {:.5g}) is inverted or degenerate "
-                                    "(area {:.3g}) in the accepted mesh", e, c.x(), c.y(), area));
+      throw SolverError(
+          fmt::format("mesh motion: element {} near ({:.5g}, {:.5g}) is inverted or degenerate "
+                      "(area {:.3g}) in the accepted mesh",
+                      e, c.x(), c.y(), area));
     }
     mean_area += area / ne;
   }
@@ -76,8 +78,10 @@ void MeshMotion::Impl::build(const Eigen::MatrixX2d& positions) {
               v = k * (lambda * g.grad(a, c) * g.grad(b, d) + mu * g.grad(a, d) * g.grad(b, c) +
                        (c == d ? mu * g.grad.row(a).dot(g.grad.row(b)) : 0.0));
             }
-            if (ib >= 0) kff.emplace_back(comps * ia + c, comps * ib + d, v);
-            else kfp.emplace_back(comps * ia + c, comps * nb + d, v);
+            if (ib >= 0)
+              kff.emplace_back(comps * ia + c, comps * ib + d, v);
+            else
+              kfp.emplace_back(comps * ia + c, comps * nb + d, v);
           }
       }
     }
@@ -92,7 +96,8 @@ void MeshMotion::Impl::build(const Eigen::MatrixX2d& positions) {
       analysed = true;
     }
     solver.factorize(K);
-    if (solver.info() != Eigen::Success) throw SolverError("mesh motion: factorisation of the extension operator failed");
+    if (solver.info() != Eigen::Success)
+      throw SolverError("mesh motion: factorisation of the extension operator failed");
   }
 }
 
@@ -109,7 +114,8 @@ Eigen::MatrixX2d MeshMotion::Impl::solve(const Eigen::MatrixX2d& prescribed) con
     for (int i = 0; i < nodes; ++i) p.segment<2>(2 * i) = prescribed.row(i).transpose();
     const Eigen::VectorXd free = solver.solve(Eigen::VectorXd(-(coupling * p)));
     for (int i = 0; i < nodes; ++i)
-      if (const int f = free_index[static_cast<std::size_t>(i)]; f >= 0) result.row(i) = free.segment<2>(2 * f).transpose();
+      if (const int f = free_index[static_cast<std::size_t>(i)]; f >= 0)
+        result.row(i) = free.segment<2>(2 * f).transpose();
   }
   return result;
 }

@@ -1,10 +1,9 @@
 #include "fsi/fluid/mesh_quality.hpp"
 
-
-#include "fsi/fluid/p2p1_element.hpp"
-
 #include <algorithm>
 #include <cmath>
+
+#include "fsi/fluid/p2p1_element.hpp"
 
 namespace fsi::fluid {
 
@@ -46,8 +45,8 @@ MeshQuality mesh_quality(const FluidMesh& mesh, const Eigen::MatrixX2d& position
   q.min_scaled_jacobian = 1e300;
   q.max_angle_deg = 0;
   for (int e = 0; e < mesh.triangle_count(); ++e) {
-    const auto [scaled, angle] = triangle_shape(positions.row(mesh.triangles(e, 0)), positions.row(mesh.triangles(e, 1)),
-                                                positions.row(mesh.triangles(e, 2)));
+    const auto [scaled, angle] = triangle_shape(
+        positions.row(mesh.triangles(e, 0)), positions.row(mesh.triangles(e, 1)), positions.row(mesh.triangles(e, 2)));
     bool bad = scaled <= 0;
     if (scaled < q.min_scaled_jacobian) q.min_scaled_jacobian = scaled, q.worst_element = e;
     q.max_angle_deg = std::max(q.max_angle_deg, angle);

@@ -1,6 +1,7 @@
 #include "fsi/fluid/navier_stokes_fluid.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -8,8 +9,6 @@
 #include <functional>
 #include <sstream>
 #include <stdexcept>
-
-#include <unistd.h>
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/common/log.hpp"
@@ -51,10 +50,14 @@ std::string read_text(const std::filesystem::path& path) {
 // text, its parameters and the element order); fluid.mesh.cache_dir overrides it.
 std::filesystem::path mesh_cache(const schema::Reader& mesh_section) {
   std::filesystem::path cache;
-  if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env) cache = env;
-  else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) cache = std::filesystem::path(xdg) / "fsi" / "meshes";
-  else if (const char* home = std::getenv("HOME"); home && *home) cache = std::filesystem::path(home) / ".cache" / "fsi" / "meshes";
-  else cache = std::filesystem::temp_directory_path() / "fsi_fluid_meshes";
+  if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env)
+    cache = env;
+  else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    cache = std::filesystem::path(xdg) / "fsi" / "meshes";
+  else if (const char* home = std::getenv("HOME"); home && *home)
+    cache = std::filesystem::path(home) / ".cache" / "fsi" / "meshes";
+  else
+    cache = std::filesystem::temp_directory_path() / "fsi_fluid_meshes";
   if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
   return cache;
 }
@@ -88,8 +91,10 @@ FluidMesh read_mesh(const schema::Reader& mesh_section, const std::filesystem::p
                                          e.what()));
   }
   if (taylor_hood && !mesh.quadratic()) {
-    fsi::logger("fluid")->info("fluid: {} has 3-node triangles; the P2/P1 elements get straight edges (mesh with gmsh "
-                               "-order 2 for curved boundaries)", msh.string());
+    fsi::logger("fluid")->info(
+        "fluid: {} has 3-node triangles; the P2/P1 elements get straight edges (mesh with gmsh "
+        "-order 2 for curved boundaries)",
+        msh.string());
     mesh = mesh.quadratic_from_linear();
   } else if (!taylor_hood && mesh.quadratic()) {
     mesh_section.fail(mesh_section.has("file") ? "file" : "geo",
@@ -181,13 +186,15 @@ std::vector<std::string> read_nitsche(const schema::Reader& section, const Fluid
     params.nitsche_penalty = penalty;
     params.nitsche_symmetry = symmetry;
   } else if (penalty != setup.nitsche_penalty || symmetry != setup.nitsche_symmetry) {
-    fsi::logger("fluid")->warn("fluid.interface.penalty/symmetry ({}, {}) differ from the coupler's gamma_N1/gamma_N2 "
-                               "({}, {}); using the coupler's", penalty, symmetry, setup.nitsche_penalty,
-                               setup.nitsche_symmetry);
+    fsi::logger("fluid")->warn(
+        "fluid.interface.penalty/symmetry ({}, {}) differ from the coupler's gamma_N1/gamma_N2 "
+        "({}, {}); using the coupler's",
+        penalty, symmetry, setup.nitsche_penalty, setup.nitsche_symmetry);
   }
   if (params.nitsche_penalty < 0) iface->fail("penalty", "gamma_N1 must be >= 0");
   params.penalty_on_step_start = iface->get<std::string>("penalty_geometry") == "step_start";
-  if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1) iface->fail("symmetry", "gamma_N2 must be +1 or -1");
+  if (params.nitsche_symmetry != 1 && params.nitsche_symmetry != -1)
+    iface->fail("symmetry", "gamma_N2 must be +1 or -1");
   return groups;
 }
 
@@ -202,9 +209,12 @@ const char* scheme_name(TimeScheme scheme) {
 VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& mesh, const std::string& group) {
   const auto profile = inflow.get<std::string>("profile");
   double umax = 0;
-  if (inflow.has("max_velocity")) umax = inflow.get<double>("max_velocity");
-  else if (inflow.has("mean_velocity")) umax = (profile == "parabolic" ? 1.5 : 1.0) * inflow.get<double>("mean_velocity");
-  else inflow.fail("max_velocity", "give max_velocity or mean_velocity");
+  if (inflow.has("max_velocity"))
+    umax = inflow.get<double>("max_velocity");
+  else if (inflow.has("mean_velocity"))
+    umax = (profile == "parabolic" ? 1.5 : 1.0) * inflow.get<double>("mean_velocity");
+  else
+    inflow.fail("max_velocity", "give max_velocity or mean_velocity");
   const Eigen::Vector2d direction = vector2(inflow, "direction").normalized();
   const double ramp = inflow.get<double>("ramp_time");
   // Extent of the inlet along its tangent.
@@ -233,8 +243,10 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
     pulse_frequency = pulse->get<double>("frequency");
   }
   std::function<double(double)> shape;
-  if (profile == "parabolic") shape = [](double s) { return 4 * s * (1 - s); };
-  else shape = [](double) { return 1.0; };
+  if (profile == "parabolic")
+    shape = [](double s) { return 4 * s * (1 - s); };
+  else
+    shape = [](double) { return 1.0; };
   return [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
     const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
     const double factor = ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
@@ -261,13 +273,15 @@ std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<
   for (const auto& [name, value] : parameters) cmd += fmt::format(" -setnumber {} {:.17g}", name, value);
   cmd += fmt::format(" '{}' -o '{}' > '{}' 2>&1", geo.string(), tmp.string(), log_file.string());
   std::string what;
-  for (const auto& [name, value] : parameters) what += fmt::format("{}{} = {:g}", what.empty() ? "" : ", ", name, value);
+  for (const auto& [name, value] : parameters)
+    what += fmt::format("{}{} = {:g}", what.empty() ? "" : ", ", name, value);
   fsi::logger("fluid")->info("meshing {} with gmsh ({}{}; log {})", geo.filename().string(), what,
                              order != 1 ? fmt::format(", order {}", order) : "", log_file.string());
   fsi::logger("fluid")->debug("{}", cmd);
   const int rc = std::system(cmd.c_str());
   if (rc != 0 || !std::filesystem::exists(tmp))
-    throw std::runtime_error(fmt::format("gmsh failed on '{}' (exit {}): {}\n{}", geo.string(), rc, cmd, read_text(log_file)));
+    throw std::runtime_error(
+        fmt::format("gmsh failed on '{}' (exit {}): {}\n{}", geo.string(), rc, cmd, read_text(log_file)));
   std::filesystem::rename(tmp, out);
   return out;
 }
@@ -302,16 +316,19 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
   configure_output(section, params.density);
   if (section.has("initial_state")) load_initial_state(section.path("initial_state"));
 
-  fsi::logger("fluid")->info("fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, "
-                             "mesh {}", element_, taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(),
-                             fluid_mesh.triangle_count(), solver_->dofs(), scheme_name(params.scheme),
-                             params.newton ? "newton" : "picard", solver_->interface_nodes().size(), msh.string());
+  fsi::logger("fluid")->info(
+      "fluid: {} ({}), {} nodes, {} triangles, {} unknowns, scheme {}, {}, {} interface nodes, "
+      "mesh {}",
+      element_, taylor_hood ? "Taylor-Hood" : "SUPG/PSPG", fluid_mesh.node_count(), fluid_mesh.triangle_count(),
+      solver_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard",
+      solver_->interface_nodes().size(), msh.string());
   start_ = last_log_ = std::chrono::steady_clock::now();
 }
 
 // fluid.inflow, walls, moving_walls, symmetry, outlet and pressure_reference on the solver.
 // Returns the groups with a condition (the mesh motion holds them fixed).
-std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema::Reader& section, const std::string& msh) {
+std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema::Reader& section,
+                                                                    const std::string& msh) {
   const auto& mesh = solver_->mesh();
   std::vector<std::string> fixed;
   // Each condition is kept, to set it on the solver of a new mesh (remeshing).
@@ -320,7 +337,9 @@ std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema
     void add_dirichlet(const std::string& g, VelocityFunction f) {
       self.conditions_.push_back([g, f](FlowSolver& s) { s.add_dirichlet(g, f); });
     }
-    void add_symmetry(const std::string& g) { self.conditions_.push_back([g](FlowSolver& s) { s.add_symmetry(g); }); }
+    void add_symmetry(const std::string& g) {
+      self.conditions_.push_back([g](FlowSolver& s) { s.add_symmetry(g); });
+    }
     void set_pressure_reference(const Eigen::Vector2d& p, std::function<double(double)> v) {
       self.conditions_.push_back([p, v](FlowSolver& s) { s.set_pressure_reference(p, v); });
     }
@@ -405,7 +424,8 @@ void NavierStokesFluid::build_mesh_motion() {
   } else {
     motion_mesh_ = fluid_mesh.linear_refinement();
   }
-  motion_ = std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion_options_);  // keeps a pointer to motion_mesh_
+  motion_ =
+      std::make_unique<MeshMotion>(motion_mesh_, moving, fixed, motion_options_);  // keeps a pointer to motion_mesh_
 }
 
 // Force probes, pressure probes and differences, VTK (fluid.forces, pressure_probes,
@@ -452,7 +472,8 @@ void NavierStokesFluid::read_remesh(const schema::Reader& section, bool moving) 
   remesh_.min_quality = rm.get<double>("min_quality");
   remesh_.min_curved_jacobian = rm.get<double>("min_curved_jacobian");
   remesh_.at_steps = rm.get_or<std::vector<int>>("at_steps", {});
-  if (remesh_.enabled && !moving) rm.fail("enabled", "the quality trigger needs a moving mesh (fluid.interface.groups)");
+  if (remesh_.enabled && !moving)
+    rm.fail("enabled", "the quality trigger needs a moving mesh (fluid.interface.groups)");
 }
 
 // Replaces the solver by one on a new mesh of the current (accepted) domain, keeping every
@@ -469,8 +490,10 @@ void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
   bool same = oi.size() == ni.size();
   for (std::size_t k = 0; same && k < ni.size(); ++k) same = r.old_node[static_cast<std::size_t>(ni[k])] == oi[k];
   if (!same)
-    throw SolverError(fmt::format("step {}: remeshing changed the interface nodes ({} -> {}); the coupler's mapping "
-                                  "would not fit", info.step, oi.size(), ni.size()));
+    throw SolverError(
+        fmt::format("step {}: remeshing changed the interface nodes ({} -> {}); the coupler's mapping "
+                    "would not fit",
+                    info.step, oi.size(), ni.size()));
   const TransferReport transfer = fresh->transfer_state(old, r.old_node);
   if (motion_ && last_interface_displacement_.size() > 0) {
     if (remesh_offset_.size() != last_interface_displacement_.size())
@@ -483,17 +506,20 @@ void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
   remesh_size_ = std::move(r.vertex_size);
   if (motion_) build_mesh_motion();
   const MeshQuality after = mesh_quality(solver_->mesh(), solver_->mesh().nodes);
-  remesh_quality_ = std::min(after.min_scaled_jacobian, solver_->mesh().quadratic() ? after.min_curved_jacobian / remesh_.min_curved_jacobian * remesh_.min_quality : 1.0);
+  remesh_quality_ = std::min(after.min_scaled_jacobian,
+                             solver_->mesh().quadratic()
+                                 ? after.min_curved_jacobian / remesh_.min_curved_jacobian * remesh_.min_quality
+                                 : 1.0);
   ++remeshes_;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   remesh_seconds_ += seconds;
-  fsi::logger("fluid")->info("fluid: remesh {} at step {} (t = {:.6g}; {}): {} -> {} nodes, scaled Jacobian {:.3g} -> "
-                             "{:.3g}, max angle {:.1f} -> {:.1f} deg; {} of {} points outside the old mesh (by <= "
-                             "{:.2e}); {:.3f} s ({:.3f} s in gmsh)",
-                             remeshes_, info.step, info.time, why, old_nodes, solver_->mesh().node_count(),
-                             before.min_scaled_jacobian, after.min_scaled_jacobian, before.max_angle_deg,
-                             after.max_angle_deg, transfer.outside, transfer.points, transfer.max_distance, seconds,
-                             r.seconds);
+  fsi::logger("fluid")->info(
+      "fluid: remesh {} at step {} (t = {:.6g}; {}): {} -> {} nodes, scaled Jacobian {:.3g} -> "
+      "{:.3g}, max angle {:.1f} -> {:.1f} deg; {} of {} points outside the old mesh (by <= "
+      "{:.2e}); {:.3f} s ({:.3f} s in gmsh)",
+      remeshes_, info.step, info.time, why, old_nodes, solver_->mesh().node_count(), before.min_scaled_jacobian,
+      after.min_scaled_jacobian, before.max_angle_deg, after.max_angle_deg, transfer.outside, transfer.points,
+      transfer.max_distance, seconds, r.seconds);
 }
 
 // A solver on `mesh` with the scene's conditions and interface.
@@ -513,16 +539,17 @@ Eigen::VectorXd index_vector(const int* data, Eigen::Index n) {
 template <class M>
 void index_matrix(const StateArchive& state, const std::string& name, M& m, Eigen::Index cols) {
   const Eigen::VectorXd v = state.vector(name);
-  if (v.size() % cols != 0) throw StateError(fmt::format("entry '{}' has {} values, not a multiple of {}", name, v.size(), cols));
+  if (v.size() % cols != 0)
+    throw StateError(fmt::format("entry '{}' has {} values, not a multiple of {}", name, v.size(), cols));
   m.resize(v.size() / cols, cols);
   for (Eigen::Index i = 0; i < v.size(); ++i) m.data()[i] = static_cast<int>(v(i));
 }
 }  // namespace
 
 // Checkpoints hold the current mesh (the scene's until a remesh): remesh.count, remesh.offset (the interface
-// displacement at the last remesh), remesh.quality, remesh.size (the target size per vertex), remesh.nodes (column-major), remesh.triangles,
-// remesh.edge_nodes (row-major), remesh.vertex_count, remesh.groups (names, one a line) and per
-// group remesh.boundary.NAME and remesh.midpoints.NAME.
+// displacement at the last remesh), remesh.quality, remesh.size (the target size per vertex), remesh.nodes
+// (column-major), remesh.triangles, remesh.edge_nodes (row-major), remesh.vertex_count, remesh.groups (names, one a
+// line) and per group remesh.boundary.NAME and remesh.midpoints.NAME.
 void NavierStokesFluid::save_remeshed(StateArchive& state) const {
   const auto& m = solver_->mesh();
   state.put("remesh.count", static_cast<std::int64_t>(remeshes_));
@@ -593,17 +620,19 @@ void NavierStokesFluid::load_initial_state(const std::filesystem::path& file) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto state = StateArchive::parse(read_text(file), file.string());
   if (!state.has("remesh.nodes"))
-    throw StateError(fmt::format("{}: the checkpoint holds no fluid mesh (written before checkpoints held it)",
-                                 file.string()));
+    throw StateError(
+        fmt::format("{}: the checkpoint holds no fluid mesh (written before checkpoints held it)", file.string()));
   FlowSolver old(mesh_from_state(state), solver_->parameters(), state.text("flow.element"));
   if (state.vector("flow.interface_velocity").size() > 0) old.set_interface(interface_groups_);
   old.load_state(state, "flow.");
-  const TransferReport r = solver_->transfer_state(old, std::vector<int>(static_cast<std::size_t>(solver_->mesh().node_count()), -1));
+  const TransferReport r =
+      solver_->transfer_state(old, std::vector<int>(static_cast<std::size_t>(solver_->mesh().node_count()), -1));
   solver_->restart_history();
-  fsi::logger("fluid")->info("fluid: initial state from {} ({} on {} nodes): {} of {} points outside its mesh (by <= "
-                             "{:.2e}); {:.3f} s",
-                             file.string(), state.text("flow.element"), old.mesh().node_count(), r.outside, r.points,
-                             r.max_distance, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  fsi::logger("fluid")->info(
+      "fluid: initial state from {} ({} on {} nodes): {} of {} points outside its mesh (by <= "
+      "{:.2e}); {:.3f} s",
+      file.string(), state.text("flow.element"), old.mesh().node_count(), r.outside, r.points, r.max_distance,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
 Eigen::VectorXd NavierStokesFluid::motion_input(const Eigen::VectorXd& interface_displacement) const {
@@ -663,8 +692,8 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   try {
     last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
   } catch (const SolverError& e) {
-    throw SolverError(fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration,
-                                  e.what()));
+    throw SolverError(
+        fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration, e.what()));
   }
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ++solves_;
@@ -677,11 +706,12 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   assembly_seconds_ += last_report_.assembly_seconds;
   factor_seconds_ += last_report_.factor_seconds;
   linear_solve_seconds_ += last_report_.solve_seconds;
-  fsi::logger("fluid")->debug("step {} t={:.5g}: {} iteration(s), change {:.2e}, assembly {:.3f}s, {} factorisation(s) "
-                              "{:.3f}s, {} BiCGSTAB iterations, solve {:.3f}s",
-                              info.step, info.time, last_report_.iterations, last_report_.change,
-                              last_report_.assembly_seconds, last_report_.factorisations, last_report_.factor_seconds,
-                              last_report_.krylov_iterations, last_report_.solve_seconds);
+  fsi::logger("fluid")->debug(
+      "step {} t={:.5g}: {} iteration(s), change {:.2e}, assembly {:.3f}s, {} factorisation(s) "
+      "{:.3f}s, {} BiCGSTAB iterations, solve {:.3f}s",
+      info.step, info.time, last_report_.iterations, last_report_.change, last_report_.assembly_seconds,
+      last_report_.factorisations, last_report_.factor_seconds, last_report_.krylov_iterations,
+      last_report_.solve_seconds);
   return loads;
 }
 
@@ -713,13 +743,13 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
   }
   // Remeshing (after the probes: they are the step's, on the mesh it was solved on).
   if (remesh_.enabled || !remesh_.at_steps.empty()) {
-    const bool forced = std::find(remesh_.at_steps.begin(), remesh_.at_steps.end(), info.step) != remesh_.at_steps.end();
+    const bool forced =
+        std::find(remesh_.at_steps.begin(), remesh_.at_steps.end(), info.step) != remesh_.at_steps.end();
     // Below the threshold, and below what the last remesh reached (a remesh that could not
     // reach the threshold, e.g. at a sharp boundary corner, is not repeated every step).
-    const double worst = std::min(q.min_scaled_jacobian, solver_->mesh().quadratic()
-                                                             ? q.min_curved_jacobian / remesh_.min_curved_jacobian *
-                                                                   remesh_.min_quality
-                                                             : 1.0);
+    const double worst = std::min(
+        q.min_scaled_jacobian,
+        solver_->mesh().quadratic() ? q.min_curved_jacobian / remesh_.min_curved_jacobian * remesh_.min_quality : 1.0);
     const bool poor = remesh_.enabled && motion_ && worst < remesh_.min_quality && worst < 0.9 * remesh_quality_;
     if (forced) {
       remesh(info, "forced (fluid.remesh.at_steps)");
@@ -742,7 +772,8 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
     const double eta = done > 0 ? elapsed * (1 - done) / done : 0.0;
     std::string extra;
     for (const auto& [k, v] : probes)
-      if (k != "nonlinear_change" && k != "nonlinear_iterations" && k != "factorisations" && k.rfind("mesh_", 0) != 0) extra += fmt::format(" {}={:.6g}", k, v);
+      if (k != "nonlinear_change" && k != "nonlinear_iterations" && k != "factorisations" && k.rfind("mesh_", 0) != 0)
+        extra += fmt::format(" {}={:.6g}", k, v);
     // Debug only: the runner's progress line (step, time, iterations, ETA) is the one at info.
     fsi::logger("fluid")->debug("step {} t={:.4f}/{:.4g} ({:.0f}%) elapsed {:.1f}s ETA {:.1f}s |{}", info.step,
                                 info.time, setup_.end_time, 100 * done, elapsed, eta, extra);
@@ -763,16 +794,19 @@ void NavierStokesFluid::save_state(StateArchive& state) {
 void NavierStokesFluid::load_state(const StateArchive& state) {
   if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
   if (const auto saved = state.text("flow.element"); saved != element_)
-    throw StateError(fmt::format("entry 'flow.element' is '{}', this configuration uses fluid.element {}", saved, element_));
+    throw StateError(
+        fmt::format("entry 'flow.element' is '{}', this configuration uses fluid.element {}", saved, element_));
   load_remeshed(state);  // the state's mesh (the scene's, or a remeshed one)
   if (!motion_ && state.has("mesh.base_displacement"))
-    throw StateError("entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
+    throw StateError(
+        "entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
   const Eigen::VectorXd last = state.vector("fluid.last_interface_displacement");
   const auto interface_size = 2 * static_cast<Eigen::Index>(solver_->interface_nodes().size());
   if (last.size() != 0 && last.size() != interface_size)
-    throw StateError(fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration needs {} "
-                                 "(a different mesh or scene?)",
-                                 last.size(), interface_size));
+    throw StateError(
+        fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration needs {} "
+                    "(a different mesh or scene?)",
+                    last.size(), interface_size));
   const auto factorisations = state.integer("fluid.factorisations"), solves = state.integer("fluid.solves");
   solver_->load_state(state, "flow.");
   if (motion_) motion_->load_state(state, "mesh.");

@@ -1,7 +1,6 @@
 // The keys of `fluid.model: fem`, declared once beside their reader (navier_stokes_fluid.cpp).
-#include "fsi/fluid/navier_stokes_fluid.hpp"
-
 #include "fsi/common/scene_schema.hpp"
+#include "fsi/fluid/navier_stokes_fluid.hpp"
 
 namespace fsi::fluid {
 
@@ -21,8 +20,7 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                             "algorithm, nflag and nflagt for a conforming flag; see its header)",
                             number("<name>", "value"))
                       .only_when("geo"),
-                  text("cache_dir", "mesh cache; default $FSI_MESH_CACHE, else ~/.cache/fsi/meshes")
-                      .only_when("geo"),
+                  text("cache_dir", "mesh cache; default $FSI_MESH_CACHE, else ~/.cache/fsi/meshes").only_when("geo"),
                   string_list("domain", "2D physical group(s) of the fluid; default: every triangle group"),
               })
           .req(),
@@ -37,25 +35,25 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                   choice("method", {"picard", "newton"}, "Oseen iterations or Newton")
                       .def_computed("newton for steady P2/P1, else picard"),
               }),
-      section("stabilisation", "SUPG/PSPG/LSIC (P1/P1) or SUPG/grad-div (P2/P1)",
-              {
-                  boolean("supg", "streamline upwind Petrov-Galerkin").def_computed("true (P1/P1), false (P2/P1)"),
-                  number("viscous_constant", "c in tau_M^-2 = (2/dt)^2 + (2|a|/h)^2 + (c 4 nu/h^2)^2").def("3"),
-                  boolean("transient_tau", "include the (2/dt)^2 term in tau_M").def("true"),
-                  boolean("pspg", "pressure-stabilising Petrov-Galerkin").def("true").only_when(element, {"p1p1"},
-                                                                                               "p1p1"),
-                  number("lsic_scale", "multiplies tau_C = h^2 / (8 tau_M); 0 = no LSIC")
-                      .def("1")
-                      .only_when(element, {"p1p1"}, "p1p1"),
-                  boolean("viscous_residual", "include the reconstructed div(mu grad u) in the residual")
-                      .def("false")
-                      .only_when(element, {"p1p1"}, "p1p1"),
-                  number("grad_div", "gamma in gamma (div w, div u)")
-                      .def("0")
-                      .ge(0)
-                      .in_unit("Pa s")
-                      .only_when(element, {"p2p1"}, "p1p1"),
-              }),
+      section(
+          "stabilisation", "SUPG/PSPG/LSIC (P1/P1) or SUPG/grad-div (P2/P1)",
+          {
+              boolean("supg", "streamline upwind Petrov-Galerkin").def_computed("true (P1/P1), false (P2/P1)"),
+              number("viscous_constant", "c in tau_M^-2 = (2/dt)^2 + (2|a|/h)^2 + (c 4 nu/h^2)^2").def("3"),
+              boolean("transient_tau", "include the (2/dt)^2 term in tau_M").def("true"),
+              boolean("pspg", "pressure-stabilising Petrov-Galerkin").def("true").only_when(element, {"p1p1"}, "p1p1"),
+              number("lsic_scale", "multiplies tau_C = h^2 / (8 tau_M); 0 = no LSIC")
+                  .def("1")
+                  .only_when(element, {"p1p1"}, "p1p1"),
+              boolean("viscous_residual", "include the reconstructed div(mu grad u) in the residual")
+                  .def("false")
+                  .only_when(element, {"p1p1"}, "p1p1"),
+              number("grad_div", "gamma in gamma (div w, div u)")
+                  .def("0")
+                  .ge(0)
+                  .in_unit("Pa s")
+                  .only_when(element, {"p2p1"}, "p1p1"),
+          }),
       integer("threads", "assembly threads (OpenMP)").def("1"),
       integer("umfpack_irstep", "UMFPACK iterative refinement steps").def("0").ge(0).le(2),
       section("linear_solver", "sparse LU (UMFPACK) and its reuse as a BiCGSTAB preconditioner",
@@ -69,32 +67,35 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                   integer("krylov_refactor_iterations", "a solve needing more marks the factors stale").def("8"),
                   boolean("adaptive_refactorisation", "refactorise when that is cheaper per solve").def("true"),
               }),
-      section("interface", "the fluid-structure interface",
-              {
-                  string_list("groups", "boundary group(s) of the interface").def("[]"),
-                  number("penalty", "gamma_N1 of standalone runs (coupled: coupling.gamma_n1)").def_computed("0").ge(0),
-                  choice("penalty_geometry", {"current", "step_start"},
-                         "the Nitsche penalty term (and f_v, M_f) on the interface of this solve, or of the last "
-                         "accepted step (M_G constant within a step: robust converged Algorithm 2 at large gamma_N1)")
-                      .def("current"),
-                  number("symmetry", "gamma_N2 of standalone runs (coupled: coupling.gamma_n2)")
-                      .def_computed("-1")
-                      .values({"1", "-1"}),
-                  number("mesh_stiffening", "mesh motion: stiffening of small elements").def("1").only_when("groups"),
-                  choice("mesh_motion", {"harmonic", "elastic"}, "mesh motion: the extension of the interface "
-                                                                 "displacement")
-                      .def("harmonic")
-                      .only_when("groups"),
-                  boolean("mesh_incremental", "mesh motion from the last configuration").def("false").only_when(
-                      "groups"),
-                  choice("mesh_motion_nodes", {"vertices", "all"}, "P2 meshes: extend on the vertices or on every "
-                                                                   "node")
-                      .def("vertices")
-                      .only_when("groups")
-                      .only_when(element, {"p2p1"}, "p1p1"),
-              }),
-      text("initial_state", "fluid.state of another run's checkpoint (fsi run --initial-state RUN_DIR): start from "
-                            "its velocity and pressure, interpolated onto this mesh"),
+      section(
+          "interface", "the fluid-structure interface",
+          {
+              string_list("groups", "boundary group(s) of the interface").def("[]"),
+              number("penalty", "gamma_N1 of standalone runs (coupled: coupling.gamma_n1)").def_computed("0").ge(0),
+              choice("penalty_geometry", {"current", "step_start"},
+                     "the Nitsche penalty term (and f_v, M_f) on the interface of this solve, or of the last "
+                     "accepted step (M_G constant within a step: robust converged Algorithm 2 at large gamma_N1)")
+                  .def("current"),
+              number("symmetry", "gamma_N2 of standalone runs (coupled: coupling.gamma_n2)")
+                  .def_computed("-1")
+                  .values({"1", "-1"}),
+              number("mesh_stiffening", "mesh motion: stiffening of small elements").def("1").only_when("groups"),
+              choice("mesh_motion", {"harmonic", "elastic"},
+                     "mesh motion: the extension of the interface "
+                     "displacement")
+                  .def("harmonic")
+                  .only_when("groups"),
+              boolean("mesh_incremental", "mesh motion from the last configuration").def("false").only_when("groups"),
+              choice("mesh_motion_nodes", {"vertices", "all"},
+                     "P2 meshes: extend on the vertices or on every "
+                     "node")
+                  .def("vertices")
+                  .only_when("groups")
+                  .only_when(element, {"p2p1"}, "p1p1"),
+          }),
+      text("initial_state",
+           "fluid.state of another run's checkpoint (fsi run --initial-state RUN_DIR): start from "
+           "its velocity and pressure, interpolated onto this mesh"),
       section("remesh", "remeshing when the moving mesh's quality drops (boundary nodes kept, interior by gmsh)",
               {
                   boolean("enabled", "remesh when the quality falls below min_quality")
@@ -105,25 +106,23 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                       .only_when(element, {"p2p1"}, "p1p1"),
                   int_list("at_steps", 0, "remesh after these steps in any case (tests)"),
               }),
-      section_list("inflow", "velocity inlets",
-                   {
-                       text("group", "boundary group").req(),
-                       choice("profile", {"parabolic", "uniform"}, "velocity profile").def("parabolic"),
-                       number("max_velocity", "peak velocity").group("velocity").in_unit("m/s"),
-                       number("mean_velocity", "mean velocity (parabolic: peak = 1.5 mean)")
-                           .group("velocity")
-                           .in_unit("m/s"),
-                       vector2("direction", "flow direction").def("[1, 0]"),
-                       number("ramp_time", "(1 - cos) ramp from 0").def("0").in_unit("s"),
-                       point_pair("profile_extent", "[[x0, y0], [x1, y1]]: ends of the full profile")
-                           .in_unit("m"),
-                       section("pulsation", "factor mean + amplitude sin(2 pi frequency t)",
-                               {
-                                   number("mean", "mean factor").def("1"),
-                                   number("amplitude", "amplitude").req(),
-                                   number("frequency", "frequency").req().in_unit("Hz"),
-                               }),
-                   })
+      section_list(
+          "inflow", "velocity inlets",
+          {
+              text("group", "boundary group").req(),
+              choice("profile", {"parabolic", "uniform"}, "velocity profile").def("parabolic"),
+              number("max_velocity", "peak velocity").group("velocity").in_unit("m/s"),
+              number("mean_velocity", "mean velocity (parabolic: peak = 1.5 mean)").group("velocity").in_unit("m/s"),
+              vector2("direction", "flow direction").def("[1, 0]"),
+              number("ramp_time", "(1 - cos) ramp from 0").def("0").in_unit("s"),
+              point_pair("profile_extent", "[[x0, y0], [x1, y1]]: ends of the full profile").in_unit("m"),
+              section("pulsation", "factor mean + amplitude sin(2 pi frequency t)",
+                      {
+                          number("mean", "mean factor").def("1"),
+                          number("amplitude", "amplitude").req(),
+                          number("frequency", "frequency").req().in_unit("Hz"),
+                      }),
+          })
           .def("[]"),
       string_list("walls", "no-slip boundary groups").def("[]"),
       section_list("moving_walls", "boundary groups with a given velocity",
@@ -139,22 +138,23 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                   vector2("point", "where").req().in_unit("m"),
                   number("value", "pressure there").def("0").in_unit("Pa"),
               }),
-      section_list("forces", "force probes (NAMEdrag, NAMElift)",
-                   {
-                       text("name", "probe prefix").def("\"\""),
-                       string_list("groups", "boundary group(s)").req(),
-                       number("reference_velocity", "with reference_length: coefficients C_D, C_L").in_unit("m/s"),
-                       number("reference_length", "reference length").req().only_when("reference_velocity").in_unit(
-                           "m"),
-                   })
+      section_list(
+          "forces", "force probes (NAMEdrag, NAMElift)",
+          {
+              text("name", "probe prefix").def("\"\""),
+              string_list("groups", "boundary group(s)").req(),
+              number("reference_velocity", "with reference_length: coefficients C_D, C_L").in_unit("m/s"),
+              number("reference_length", "reference length").req().only_when("reference_velocity").in_unit("m"),
+          })
           .def("[]"),
       named_map("pressure_probes", "pressure at points, name: [x, y]", vector2("<name>", "point").in_unit("m")),
       named_map("pressure_differences", "name: [high, low] (two pressure probes)",
                 string_list("<name>", "two pressure probe names").count(2)),
       section("output", "fluid output",
               {
-                  integer("vtk_every", "VTK only at steps that are multiples of N; 0 = never; default: every "
-                                       "output step")
+                  integer("vtk_every",
+                          "VTK only at steps that are multiples of N; 0 = never; default: every "
+                          "output step")
                       .ge(0)
                       .in_unit("steps"),
               }),

@@ -38,7 +38,8 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
     const double s = (dN * a_c.transpose()).cwiseAbs().sum();
     if (s > 0) h_adv = 2.0 * a_norm / s;
   }
-  double inv_tau2 = std::pow(2.0 * a_norm / h_adv, 2) + std::pow(stab.viscous_constant * 4.0 * nu / (h_size * h_size), 2);
+  double inv_tau2 =
+      std::pow(2.0 * a_norm / h_adv, 2) + std::pow(stab.viscous_constant * 4.0 * nu / (h_size * h_size), 2);
   if (stab.transient_tau && in.dt > 0) inv_tau2 += std::pow(2.0 / in.dt, 2);
   const double tau_m = 1.0 / std::sqrt(inv_tau2);
   const double tau_c = stab.lsic_scale * h_size * h_size / (8.0 * tau_m);
@@ -48,7 +49,8 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
   const double tau_pspg = stab.pspg ? tau_m : 0.0;
 
   // Three-point rule (exact for quadratics): barycentric (2/3, 1/6, 1/6) and permutations.
-  static const double kN[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
+  static const double kN[3][3] = {
+      {2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
   const double w = area / 3.0;
   // Newton: the Galerkin convection's derivative (du . grad) u_k, grad u_k constant in P1.
   const Eigen::Matrix2d Gu = in.newton ? Eigen::Matrix2d(in.velocity.transpose() * dN) : Eigen::Matrix2d::Zero();
@@ -68,7 +70,8 @@ void assemble_element(const ElementInput& in, const StabilisationParameters& sta
       }
       if (in.newton) {
         const Eigen::RowVector2d uk = N.transpose() * in.velocity;
-        for (int c = 0; c < 2; ++c) out.rhs(3 * i + c) += w * N(i) * rho * uk.dot(Gu.row(c));  // (w, rho (u_k . grad) u_k)
+        for (int c = 0; c < 2; ++c)
+          out.rhs(3 * i + c) += w * N(i) * rho * uk.dot(Gu.row(c));  // (w, rho (u_k . grad) u_k)
       }
       out.rhs(3 * i + 2) += w * (tau_pspg / rho) * dN.row(i).dot(src_stab);
       for (int j = 0; j < 3; ++j) {

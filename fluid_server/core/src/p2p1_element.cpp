@@ -1,7 +1,6 @@
 #include "fsi/fluid/p2p1_element.hpp"
 
 #include <Eigen/LU>
-
 #include <array>
 #include <cmath>
 #include <limits>
@@ -15,9 +14,8 @@ struct QuadraturePoint {
 };
 constexpr double a1 = 0.059715871789770, b1 = 0.470142064105115, w1 = 0.132394152788506;
 constexpr double a2 = 0.797426985353087, b2 = 0.101286507323456, w2 = 0.125939180544827;
-constexpr std::array<QuadraturePoint, 7> kRule = {{{1.0 / 3, 1.0 / 3, 0.225},
-                                                   {b1, b1, w1}, {a1, b1, w1}, {b1, a1, w1},
-                                                   {b2, b2, w2}, {a2, b2, w2}, {b2, a2, w2}}};
+constexpr std::array<QuadraturePoint, 7> kRule = {
+    {{1.0 / 3, 1.0 / 3, 0.225}, {b1, b1, w1}, {a1, b1, w1}, {b1, a1, w1}, {b2, b2, w2}, {a2, b2, w2}, {b2, a2, w2}}};
 
 // Reference Hessians of the P2 shape functions (constant): d2N/dxi_a dxi_b.
 std::array<Eigen::Matrix2d, 6> reference_hessians() {

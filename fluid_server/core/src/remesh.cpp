@@ -1,7 +1,5 @@
 #include "fsi/fluid/remesh.hpp"
 
-#include "fsi/fluid/field_transfer.hpp"
-
 #include <fmt/format.h>
 #include <gmsh.h>
 
@@ -11,6 +9,8 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+
+#include "fsi/fluid/field_transfer.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -60,7 +60,8 @@ Eigen::VectorXd reference_sizes(const FluidMesh& mesh) {
   const int nv = mesh.vertices();
   Eigen::VectorXd size = Eigen::VectorXd::Zero(nv), count = Eigen::VectorXd::Zero(nv);
   for (int e = 0; e < mesh.triangle_count(); ++e) {
-    const double area = std::abs(signed_area(mesh.nodes, mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)));
+    const double area =
+        std::abs(signed_area(mesh.nodes, mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)));
     const double h = std::sqrt(4 * area / std::sqrt(3.0));
     for (int k = 0; k < 3; ++k) size(mesh.triangles(e, k)) += h, count(mesh.triangles(e, k)) += 1;
   }
@@ -90,8 +91,10 @@ RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions, co
   for (std::size_t j = 0; j < edges.size(); ++j) {
     int& slot = out_edge[static_cast<std::size_t>(edges[j].a)];
     if (slot >= 0)
-      throw std::runtime_error(fmt::format("remesh: the boundary touches itself at node {} (two boundary edges start "
-                                           "there)", edges[j].a));
+      throw std::runtime_error(
+          fmt::format("remesh: the boundary touches itself at node {} (two boundary edges start "
+                      "there)",
+                      edges[j].a));
     slot = static_cast<int>(j);
   }
   std::vector<std::vector<int>> loops;  // boundary edge indices
@@ -126,7 +129,8 @@ RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions, co
     GmshSession session;
     gmsh::model::add("remesh");
     for (std::size_t i = 0; i < kept.size(); ++i)
-      gmsh::model::geo::addPoint(positions(kept[i], 0), positions(kept[i], 1), 0.0, size(kept[i]), static_cast<int>(i) + 1);
+      gmsh::model::geo::addPoint(positions(kept[i], 0), positions(kept[i], 1), 0.0, size(kept[i]),
+                                 static_cast<int>(i) + 1);
     for (std::size_t j = 0; j < edges.size(); ++j)
       gmsh::model::geo::addLine(new_vertex[static_cast<std::size_t>(edges[j].a)] + 1,
                                 new_vertex[static_cast<std::size_t>(edges[j].b)] + 1, static_cast<int>(j) + 1);
@@ -135,8 +139,10 @@ RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions, co
       std::vector<int> curves;
       for (int j : loops[l]) curves.push_back(j + 1);
       const int w = gmsh::model::geo::addCurveLoop(curves);
-      if (l == outer) wires.insert(wires.begin(), w);
-      else wires.push_back(w);
+      if (l == outer)
+        wires.insert(wires.begin(), w);
+      else
+        wires.push_back(w);
     }
     gmsh::model::geo::addPlaneSurface(wires, 1);
     gmsh::model::geo::synchronize();
@@ -249,7 +255,8 @@ RemeshResult remesh(const FluidMesh& mesh, const Eigen::MatrixX2d& positions, co
       }
     Eigen::MatrixX2d all(nv + static_cast<Eigen::Index>(kept_mid.size() + extra.size()), 2);
     all.topRows(nv) = out.nodes;
-    for (std::size_t i = 0; i < kept_mid.size(); ++i) all.row(nv + static_cast<Eigen::Index>(i)) = positions.row(kept_mid[i]);
+    for (std::size_t i = 0; i < kept_mid.size(); ++i)
+      all.row(nv + static_cast<Eigen::Index>(i)) = positions.row(kept_mid[i]);
     for (std::size_t i = 0; i < extra.size(); ++i)
       all.row(nv + static_cast<Eigen::Index>(kept_mid.size() + i)) = extra[i];
     out.nodes = std::move(all);

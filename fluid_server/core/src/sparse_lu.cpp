@@ -1,9 +1,9 @@
 #include "fsi/fluid/sparse_lu.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/UmfPackSupport>
 #include <fmt/format.h>
 
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/UmfPackSupport>
 #include <chrono>
 
 #include "fsi/common/log.hpp"
@@ -26,10 +26,22 @@ class FrozenLuPreconditioner {
  public:
   FrozenLuPreconditioner() = default;
   void set(const LuSolver* lu) { lu_ = lu; }
-  template <class M> FrozenLuPreconditioner& analyzePattern(const M&) { return *this; }
-  template <class M> FrozenLuPreconditioner& factorize(const M&) { return *this; }
-  template <class M> FrozenLuPreconditioner& compute(const M&) { return *this; }
-  template <class R> Eigen::VectorXd solve(const Eigen::MatrixBase<R>& b) const { return lu_->solve(b); }
+  template <class M>
+  FrozenLuPreconditioner& analyzePattern(const M&) {
+    return *this;
+  }
+  template <class M>
+  FrozenLuPreconditioner& factorize(const M&) {
+    return *this;
+  }
+  template <class M>
+  FrozenLuPreconditioner& compute(const M&) {
+    return *this;
+  }
+  template <class R>
+  Eigen::VectorXd solve(const Eigen::MatrixBase<R>& b) const {
+    return lu_->solve(b);
+  }
   Eigen::ComputationInfo info() const { return Eigen::Success; }
 
  private:
@@ -45,8 +57,8 @@ struct SparseLu::Impl {
   std::unique_ptr<LuSolver> lu = std::make_unique<LuSolver>();
   bool analysed = false;
   bool factorised = false;
-  bool stale = false;  // the factors precondition poorly: refactorise at the next solve
-  double time_coefficient = 0;  // alpha0 / dt of the factorised matrix
+  bool stale = false;                // the factors precondition poorly: refactorise at the next solve
+  double time_coefficient = 0;       // alpha0 / dt of the factorised matrix
   Ordering chosen = Ordering::Auto;  // Auto until the first analysis decides (or a fixed one)
   // Cost model of the current factors (flops, see sparse_lu.hpp): one application of the
   // factors, one product with A, and the cost of the cycle so far (factorisation + solves).
@@ -64,8 +76,9 @@ SparseLu::~SparseLu() = default;
 SparseLu::SparseLu(SparseLu&&) noexcept = default;
 SparseLu& SparseLu::operator=(SparseLu&&) noexcept = default;
 
-Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, const Eigen::VectorXd& guess,
-                                StepReport& report, const std::string& where, double time_coefficient) {
+Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+                                const Eigen::VectorXd& guess, StepReport& report, const std::string& where,
+                                double time_coefficient) {
   auto& s = *impl_;
   const auto& p = s.params;
   Eigen::VectorXd x;
@@ -100,7 +113,8 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
   if (!s.analysed) {
     auto analyse = [&](LuSolver& lu, Ordering ordering) {
       lu.umfpackControl()(UMFPACK_IRSTEP) = p.umfpack_irstep;
-      lu.umfpackControl()(UMFPACK_ORDERING) = ordering == Ordering::Metis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
+      lu.umfpackControl()(UMFPACK_ORDERING) =
+          ordering == Ordering::Metis ? UMFPACK_ORDERING_METIS : UMFPACK_ORDERING_AMD;
       lu.umfpackControl()(UMFPACK_STRATEGY) = p.strategy == LuStrategy::Symmetric     ? UMFPACK_STRATEGY_SYMMETRIC
                                               : p.strategy == LuStrategy::Unsymmetric ? UMFPACK_STRATEGY_UNSYMMETRIC
                                                                                       : UMFPACK_STRATEGY_AUTO;
@@ -126,11 +140,12 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
       if (s.chosen == Ordering::Metis) std::swap(s.lu, other);
       const LuSolver& amd_lu = s.chosen == Ordering::Metis ? *other : *s.lu;
       const LuSolver& metis_lu = s.chosen == Ordering::Metis ? *s.lu : *other;
-      fsi::logger("fluid")->info("linear solver: ordering auto chose {} (first factorisation of {} unknowns: AMD {:.3g} "
-                                 "flops, nnz(L+U) {:.3g}, {:.3f} s; METIS {:.3g} flops, nnz(L+U) {:.3g}, {:.3f} s)",
-                                 s.chosen == Ordering::Metis ? "METIS" : "AMD", A.rows(), amd,
-                                 amd_lu.umfpack_info(UMFPACK_LNZ) + amd_lu.umfpack_info(UMFPACK_UNZ), amd_seconds, metis,
-                                 metis_lu.umfpack_info(UMFPACK_LNZ) + metis_lu.umfpack_info(UMFPACK_UNZ), metis_seconds);
+      fsi::logger("fluid")->info(
+          "linear solver: ordering auto chose {} (first factorisation of {} unknowns: AMD {:.3g} "
+          "flops, nnz(L+U) {:.3g}, {:.3f} s; METIS {:.3g} flops, nnz(L+U) {:.3g}, {:.3f} s)",
+          s.chosen == Ordering::Metis ? "METIS" : "AMD", A.rows(), amd,
+          amd_lu.umfpack_info(UMFPACK_LNZ) + amd_lu.umfpack_info(UMFPACK_UNZ), amd_seconds, metis,
+          metis_lu.umfpack_info(UMFPACK_LNZ) + metis_lu.umfpack_info(UMFPACK_UNZ), metis_seconds);
     } else {
       analyse(*s.lu, s.chosen);
       s.lu->factorize(A);
@@ -140,9 +155,10 @@ Eigen::VectorXd SparseLu::solve(const Eigen::SparseMatrix<double>& A, const Eige
     s.lu->factorize(A);
   }
   if (s.lu->info() != Eigen::Success)
-    throw SolverError(fmt::format("{}: UMFPACK factorisation failed (singular matrix?: check that the pressure is fixed "
-                                  "by an outlet or a pressure reference)",
-                                  where));
+    throw SolverError(
+        fmt::format("{}: UMFPACK factorisation failed (singular matrix?: check that the pressure is fixed "
+                    "by an outlet or a pressure reference)",
+                    where));
   const double factor_flops = s.lu->umfpack_info(UMFPACK_FLOPS);
   const double lu_nonzeros = s.lu->umfpack_info(UMFPACK_LNZ) + s.lu->umfpack_info(UMFPACK_UNZ);
   s.factorised = true;
@@ -180,10 +196,14 @@ void SparseLu::load_state(const StateArchive& state, const std::string& prefix) 
   auto& s = *impl_;
   const std::string name = state.text(prefix + "ordering");
   Ordering saved;
-  if (name == "amd") saved = Ordering::Amd;
-  else if (name == "metis") saved = Ordering::Metis;
-  else if (name == "auto") saved = Ordering::Auto;
-  else throw StateError(fmt::format("entry '{}ordering' is '{}', expected amd, metis or auto", prefix, name));
+  if (name == "amd")
+    saved = Ordering::Amd;
+  else if (name == "metis")
+    saved = Ordering::Metis;
+  else if (name == "auto")
+    saved = Ordering::Auto;
+  else
+    throw StateError(fmt::format("entry '{}ordering' is '{}', expected amd, metis or auto", prefix, name));
   if (s.params.ordering != Ordering::Auto && saved != Ordering::Auto && saved != s.params.ordering)
     throw StateError(fmt::format("entry '{}ordering' is '{}' but this configuration fixes linear_solver.ordering: {}",
                                  prefix, name, ordering_name(s.params.ordering)));

@@ -119,11 +119,10 @@ ElementState q4_eas_internal_force(const ElementCoords& X, const ElementVector& 
   // Strain transformation at the centre: natural (covariant) strains -> Voigt [E11, E22, 2 E12].
   const Eigen::Matrix2d J0 = X.transpose() * q4_shape_derivatives(0, 0);  // dX/dxi
   const double det0 = J0.determinant();
-  const Eigen::Matrix2d K = J0.inverse();                                  // K(A, j) = dxi_A / dX_j
+  const Eigen::Matrix2d K = J0.inverse();  // K(A, j) = dxi_A / dX_j
   Eigen::Matrix3d T0;
-  T0 << K(0, 0) * K(0, 0), K(1, 0) * K(1, 0), K(0, 0) * K(1, 0),
-        K(0, 1) * K(0, 1), K(1, 1) * K(1, 1), K(0, 1) * K(1, 1),
-        2 * K(0, 0) * K(0, 1), 2 * K(1, 0) * K(1, 1), K(0, 0) * K(1, 1) + K(1, 0) * K(0, 1);
+  T0 << K(0, 0) * K(0, 0), K(1, 0) * K(1, 0), K(0, 0) * K(1, 0), K(0, 1) * K(0, 1), K(1, 1) * K(1, 1),
+      K(0, 1) * K(1, 1), 2 * K(0, 0) * K(0, 1), 2 * K(1, 0) * K(1, 1), K(0, 0) * K(1, 1) + K(1, 0) * K(0, 1);
   const Eigen::Map<const Eigen::Matrix<double, 2, 4>> U(u.data());
   struct Point {
     double dV;

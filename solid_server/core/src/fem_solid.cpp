@@ -65,7 +65,8 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   const double nu = mat.get<double>("poisson_ratio");
   ElasticConstants constants;
   const bool has_E = mat.has("youngs_modulus"), has_mu = mat.has("shear_modulus");
-  if (has_E == has_mu) mat.fail(has_E ? "youngs_modulus" : "law", "give exactly one of youngs_modulus or shear_modulus");
+  if (has_E == has_mu)
+    mat.fail(has_E ? "youngs_modulus" : "law", "give exactly one of youngs_modulus or shear_modulus");
   if (has_E) {
     const double E = mat.get_or<double>("youngs_modulus", 0.0);
     constants = ElasticConstants::from_youngs(E, nu);
@@ -87,10 +88,14 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   if (analysis == "static") {
     scheme_ = TimeScheme::Static;
   } else if (analysis == "dynamic") {
-    if (scheme == "bdf1") scheme_ = TimeScheme::Bdf1;
-    else if (scheme == "bdf2") scheme_ = TimeScheme::Bdf2;
-    else if (scheme == "newmark") scheme_ = TimeScheme::Newmark;
-    else s.fail("time_scheme", "must be 'bdf1', 'bdf2' or 'newmark', got '" + scheme + "'");
+    if (scheme == "bdf1")
+      scheme_ = TimeScheme::Bdf1;
+    else if (scheme == "bdf2")
+      scheme_ = TimeScheme::Bdf2;
+    else if (scheme == "newmark")
+      scheme_ = TimeScheme::Newmark;
+    else
+      s.fail("time_scheme", "must be 'bdf1', 'bdf2' or 'newmark', got '" + scheme + "'");
   } else {
     s.fail("analysis", "must be 'static' or 'dynamic', got '" + analysis + "'");
   }
@@ -105,8 +110,10 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   }
   const auto solver_name = s.get<std::string>("linear_solver");
   LinearSolverKind solver_kind = LinearSolverKind::Cholmod;
-  if (solver_name == "umfpack") solver_kind = LinearSolverKind::Umfpack;
-  else if (solver_name != "cholmod") s.fail("linear_solver", "must be 'cholmod' or 'umfpack'");
+  if (solver_name == "umfpack")
+    solver_kind = LinearSolverKind::Umfpack;
+  else if (solver_name != "cholmod")
+    s.fail("linear_solver", "must be 'cholmod' or 'umfpack'");
 
   // 5. Clamps (homogeneous Dirichlet on named edges, both components).
   const auto clamp = s.names("clamp");
@@ -118,8 +125,10 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   }
   system_ = std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind);
   const auto element = s.get<std::string>("element");
-  if (element == "q4_eas") system_->set_element(ElementKind::Q4Eas);
-  else if (element != "q4") s.fail("element", "must be 'q4' (bilinear) or 'q4_eas' (enhanced assumed strain), got '" + element + "'");
+  if (element == "q4_eas")
+    system_->set_element(ElementKind::Q4Eas);
+  else if (element != "q4")
+    s.fail("element", "must be 'q4' (bilinear) or 'q4_eas' (enhanced assumed strain), got '" + element + "'");
 
   // 6. Loads: gravity (force per reference volume rho_s g), dead edge tractions, point loads.
   const Eigen::Vector2d gravity = vec2(s, "gravity");
@@ -175,7 +184,8 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   // The solid's mass over its interface measure (the automatic Robin parameter's m_s / |Gamma|):
   // the consistent mass matrix sums to 2 rho |Omega_s| (two components).
   if (interface_.lumped_measure.sum() > 0)
-    interface_.mass_per_area = 0.5 * Eigen::VectorXd(system_->mass() * Eigen::VectorXd::Ones(system_->mass().cols())).sum() /
+    interface_.mass_per_area = 0.5 *
+                               Eigen::VectorXd(system_->mass() * Eigen::VectorXd::Ones(system_->mass().cols())).sum() /
                                interface_.lumped_measure.sum();
   if (setup.interface_damping < 0) throw ConfigError("interface damping gamma_N1 must be >= 0");
   if (setup.interface_damping > 0) {
@@ -225,8 +235,8 @@ void FemSolid::set_interface_mass(const NodalMatrix& m) {
   if (!system_) throw SolverError("solid: set_interface_mass before configure");
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   if (m.rows() != n || m.cols() != n)
-    throw std::invalid_argument(fmt::format("solid: interface mass is {} x {}, expected {} x {} (interface nodes)",
-                                            m.rows(), m.cols(), n, n));
+    throw std::invalid_argument(
+        fmt::format("solid: interface mass is {} x {}, expected {} x {} (interface nodes)", m.rows(), m.cols(), n, n));
   if (!(setup_.interface_damping > 0)) return;  // no damping (Algorithm 1 or gamma_N1 = 0)
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(2 * static_cast<std::size_t>(m.nonZeros()));
@@ -262,9 +272,10 @@ void FemSolid::newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTe
   fsi::logger("solid")->debug("step {} k {}: Newton {} iterations, |R| {:.3e} -> {:.3e}", info.step, info.iteration,
                               rep.iterations, rep.initial_residual, rep.residual);
   if (!rep.converged)
-    throw SolverError(fmt::format("solid step {} (t = {:.6g}): Newton did not converge in {} iterations (|R| {:.3e}, "
-                                  "initial {:.3e})",
-                                  info.step, info.time, rep.iterations, rep.residual, rep.initial_residual));
+    throw SolverError(
+        fmt::format("solid step {} (t = {:.6g}): Newton did not converge in {} iterations (|R| {:.3e}, "
+                    "initial {:.3e})",
+                    info.step, info.time, rep.iterations, rep.residual, rep.initial_residual));
 }
 
 SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) {
@@ -384,8 +395,10 @@ std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
   VtkGrid grid;
   grid.points = mesh_.nodes;
   const int nn = mesh_.num_nodes(), nc = mesh_.num_cells();
-  grid.point_data["displacement"] = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(d_n_.data(), nn, 2);
-  grid.point_data["velocity"] = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(v_n_.data(), nn, 2);
+  grid.point_data["displacement"] =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(d_n_.data(), nn, 2);
+  grid.point_data["velocity"] =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(v_n_.data(), nn, 2);
   Eigen::MatrixXd stress(nc, 3);
   for (int c = 0; c < nc; ++c) {
     grid.cells.push_back({mesh_.cells[c].begin(), mesh_.cells[c].end()});

@@ -1,26 +1,24 @@
 // The keys of `solid.model: fem`, declared once beside their reader (fem_solid.cpp).
-#include "fsi/solid/fem_solid.hpp"
-
 #include "fsi/common/scene_schema.hpp"
+#include "fsi/solid/fem_solid.hpp"
 
 namespace fsi::solid {
 
 const std::vector<schema::Key>& fem_solid_keys() {
   using namespace schema;
   static const std::vector<Key> keys = {
-      section("mesh", "the solid mesh",
-              {
-                  choice("type", {"rectangle", "gmsh"}, "built-in structured Q4 rectangle, or a gmsh .msh file")
-                      .req(),
-                  vector2("origin", "lower-left corner").req().only_when("type", {"rectangle"}).in_unit("m"),
-                  vector2("size", "lx, ly (positive)").req().only_when("type", {"rectangle"}).in_unit("m"),
-                  int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
-                      .req()
-                      .only_when("type", {"rectangle"}),
-                  text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
-                  text("domain", "2D physical group of the solid; default: every quad group")
-                      .only_when("type", {"gmsh"}),
-              })
+      section(
+          "mesh", "the solid mesh",
+          {
+              choice("type", {"rectangle", "gmsh"}, "built-in structured Q4 rectangle, or a gmsh .msh file").req(),
+              vector2("origin", "lower-left corner").req().only_when("type", {"rectangle"}).in_unit("m"),
+              vector2("size", "lx, ly (positive)").req().only_when("type", {"rectangle"}).in_unit("m"),
+              int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
+                  .req()
+                  .only_when("type", {"rectangle"}),
+              text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
+              text("domain", "2D physical group of the solid; default: every quad group").only_when("type", {"gmsh"}),
+          })
           .req(),
       section("material", "hyperelastic material (plane strain); exactly one of youngs_modulus, shear_modulus",
               {
@@ -36,8 +34,9 @@ const std::vector<schema::Key>& fem_solid_keys() {
       number("density", "rho_s, reference configuration").req().gt(0).in_unit("kg/m^3"),
       vector2("gravity", "body force per unit mass").def("[0, 0]").in_unit("m/s^2"),
       choice("analysis", {"static", "dynamic"}, "equilibrium every step, or dynamics").def("dynamic"),
-      choice("time_scheme", {"bdf1", "bdf2", "newmark"}, "dynamic analysis: BDF1 (the paper), BDF2 or Newmark "
-                                                         "(trapezoidal)")
+      choice("time_scheme", {"bdf1", "bdf2", "newmark"},
+             "dynamic analysis: BDF1 (the paper), BDF2 or Newmark "
+             "(trapezoidal)")
           .def("newmark"),
       integer("load_steps", "load increments per step").def("1").ge(1),
       section("newton", "Newton iterations",

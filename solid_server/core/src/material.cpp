@@ -92,8 +92,7 @@ Matrix3 NeoHookean::tangent(const Kinematics& k) const {
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) {
       const int I = kI[a], J = kJ[a], K = kI[b], L = kJ[b];
-      D(a, b) = c_.lambda * Ci(I, J) * Ci(K, L) +
-                mu_eff * (Ci(I, K) * Ci(J, L) + Ci(I, L) * Ci(J, K));
+      D(a, b) = c_.lambda * Ci(I, J) * Ci(K, L) + mu_eff * (Ci(I, K) * Ci(J, L) + Ci(I, L) * Ci(J, K));
     }
   return D;
 }
@@ -112,8 +111,7 @@ Vector3 cauchy_stress(const Kinematics& k, const Vector3& S) {
 std::unique_ptr<Material> make_material(const std::string& law, ElasticConstants c) {
   if (law == "saint_venant_kirchhoff" || law == "svk") return std::make_unique<SaintVenantKirchhoff>(c);
   if (law == "neo_hookean") return std::make_unique<NeoHookean>(c);
-  throw std::invalid_argument("unknown material law '" + law +
-                              "' (known: saint_venant_kirchhoff, neo_hookean)");
+  throw std::invalid_argument("unknown material law '" + law + "' (known: saint_venant_kirchhoff, neo_hookean)");
 }
 
 }  // namespace fsi::solid

@@ -97,7 +97,8 @@ SolidMesh mesh_from_gmsh(const GmshMesh& gmsh, const std::string& domain) {
   for (const auto& g : gmsh.groups) {
     if (g.dimension != 2 || (!domain.empty() && g.name != domain)) continue;
     if (g.element_type != 3)
-      throw std::invalid_argument("gmsh group '" + g.name + "': only 4-node quadrilaterals (type 3) are supported, got type " +
+      throw std::invalid_argument("gmsh group '" + g.name +
+                                  "': only 4-node quadrilaterals (type 3) are supported, got type " +
                                   std::to_string(g.element_type));
     found = true;
     for (Eigen::Index e = 0; e < g.elements.rows(); ++e)

@@ -57,7 +57,8 @@ SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> 
                          std::vector<char> fixed_dofs, LinearSolverKind solver)
     : mesh_(mesh), material_(std::move(material)), density_(density), fixed_(std::move(fixed_dofs)), solver_(solver) {
   const int n = num_dofs();
-  if (static_cast<int>(fixed_.size()) != n) throw std::invalid_argument("SolidSystem: fixed flags must have one entry per dof");
+  if (static_cast<int>(fixed_.size()) != n)
+    throw std::invalid_argument("SolidSystem: fixed flags must have one entry per dof");
   equation_.assign(n, -1);
   for (int i = 0; i < n; ++i)
     if (!fixed_[i]) equation_[i] = static_cast<int>(free_dofs_.size()), free_dofs_.push_back(i);
@@ -66,7 +67,8 @@ SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> 
     const auto X = cell_coordinates(c);
     double area2 = 0;
     for (int a = 0; a < 4; ++a) area2 += X(a, 0) * X((a + 1) % 4, 1) - X((a + 1) % 4, 0) * X(a, 1);
-    if (!(area2 > 0)) throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
+    if (!(area2 > 0))
+      throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
   }
 
   build_pattern({});
@@ -170,8 +172,7 @@ SparseMatrix SolidSystem::boundary_mass(const std::vector<std::array<int, 2>>& e
   for (const auto& e : edges) {
     const Eigen::Matrix4d Me = edge_mass(mesh_.nodes.row(e[0]).transpose(), mesh_.nodes.row(e[1]).transpose(), weight);
     for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        C.valuePtr()[position(2 * e[a / 2] + a % 2, 2 * e[b / 2] + b % 2)] += Me(a, b);
+      for (int b = 0; b < 4; ++b) C.valuePtr()[position(2 * e[a / 2] + a % 2, 2 * e[b / 2] + b % 2)] += Me(a, b);
   }
   return C;
 }
@@ -208,7 +209,8 @@ Eigen::VectorXd SolidSystem::body_force(const std::function<Eigen::Vector2d(cons
 }
 
 ElementState SolidSystem::cell_state(int c, const Eigen::VectorXd& d, bool with_tangent) const {
-  if (element_ == ElementKind::Q4Eas) return q4_eas_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
+  if (element_ == ElementKind::Q4Eas)
+    return q4_eas_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
   return q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
 }
 
@@ -230,7 +232,8 @@ Eigen::VectorXd time_vector(double coef, const Eigen::VectorXd& d, const Eigen::
 }
 }  // namespace
 
-Eigen::VectorXd SolidSystem::residual(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t) const {
+Eigen::VectorXd SolidSystem::residual(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext,
+                                      const TimeTerms& t) const {
   Eigen::VectorXd r = internal_force(d) - f_ext;
   if (t.mass_coefficient != 0 || t.acceleration_history.size())
     r += mass_ * time_vector(t.mass_coefficient, d, t.acceleration_history);
@@ -239,8 +242,8 @@ Eigen::VectorXd SolidSystem::residual(const Eigen::VectorXd& d, const Eigen::Vec
   return r;
 }
 
-void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t,
-                           SparseMatrix& K, Eigen::VectorXd& r_free) const {
+void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t, SparseMatrix& K,
+                           Eigen::VectorXd& r_free) const {
   if (K.nonZeros() != reduced_pattern_.nonZeros()) K = reduced_pattern_;
   std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
   Eigen::VectorXd r = -f_ext;

@@ -34,8 +34,7 @@ class Scene {
   // Parses `text` (the file's content); `origin` names it in error messages.
   static Scene parse(const std::string& text, const std::string& origin,
                      const std::vector<std::string>& overrides = {});
-  static Scene load(const std::filesystem::path& path,
-                    const std::vector<std::string>& overrides = {});
+  static Scene load(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
 
   const std::string& origin() const { return state_->origin; }
   const std::string& text() const { return state_->text; }

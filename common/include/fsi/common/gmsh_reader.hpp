@@ -6,7 +6,6 @@
 // A file that is not a mesh, or a missing group, is a std::runtime_error naming the file,
 // the line and (for groups) the names that exist.
 #include <Eigen/Core>
-
 #include <filesystem>
 #include <istream>
 #include <string>
@@ -15,15 +14,15 @@
 namespace fsi {
 
 struct GmshGroup {
-  std::string name;      // physical name ("" if unnamed; then "tag<N>")
-  int dimension = 0;     // 1 = lines, 2 = surface cells
+  std::string name;   // physical name ("" if unnamed; then "tag<N>")
+  int dimension = 0;  // 1 = lines, 2 = surface cells
   int physical_tag = 0;
   int element_type = 0;  // gmsh type: 1 line2, 2 tri3, 3 quad4, 8 line3, 9 tri6, 10 quad9
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> elements;  // 0-based node indices
 };
 
 struct GmshMesh {
-  Eigen::MatrixX2d nodes;           // x, y of every node (0-based index)
+  Eigen::MatrixX2d nodes;  // x, y of every node (0-based index)
   std::vector<GmshGroup> groups;
   const GmshGroup& group(const std::string& name) const;  // throws listing known names
   bool has_group(const std::string& name) const;

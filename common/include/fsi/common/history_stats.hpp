@@ -15,10 +15,9 @@
 //    than min_periods: a mean / amplitude / frequency over them would not mean much).
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace fsi {
 

@@ -4,10 +4,9 @@
 //                 reason, steps, iterations, wall time split; rewritten at every accepted
 //                 step and at the end, so it is valid if the run dies;
 //   probes.csv    `time` then one column per probe, one row per accepted step (flushed).
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "fsi/common/config.hpp"

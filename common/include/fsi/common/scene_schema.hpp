@@ -76,7 +76,7 @@ struct Key {
   std::optional<double> lo, hi;
   bool lo_open = false, hi_open = false;
   std::string range_message;  // instead of "must be > 0" etc., e.g. "(beta) must be > 0"
-  std::string one_of;  // exactly one key of the same group (in the same map) must be given
+  std::string one_of;         // exactly one key of the same group (in the same map) must be given
   std::vector<Condition> when;
   std::vector<Key> children;  // Section, SectionList; NamedMap: one entry, the value
   int size = 0;               // IntList, StringList: the number of entries (0 = any)
@@ -92,25 +92,68 @@ struct Key {
   // documents it, and the reader computes it (Reader::get_or).
   bool computed_default = false;
 
-  Key& req() { required = true; return *this; }
-  Key& def(std::string d) { default_value = std::move(d); return *this; }
-  Key& def_computed(std::string d) { default_value = std::move(d); computed_default = true; return *this; }
-  Key& in_unit(std::string u) { unit = std::move(u); return *this; }
-  Key& values(std::vector<std::string> v) { allowed = std::move(v); return *this; }
-  Key& gt(double v) { lo = v; lo_open = true; return *this; }
-  Key& ge(double v) { lo = v; lo_open = false; return *this; }
-  Key& lt(double v) { hi = v; hi_open = true; return *this; }
-  Key& le(double v) { hi = v; hi_open = false; return *this; }
-  Key& says(std::string m) { range_message = std::move(m); return *this; }
-  Key& group(std::string g) { one_of = std::move(g); return *this; }
+  Key& req() {
+    required = true;
+    return *this;
+  }
+  Key& def(std::string d) {
+    default_value = std::move(d);
+    return *this;
+  }
+  Key& def_computed(std::string d) {
+    default_value = std::move(d);
+    computed_default = true;
+    return *this;
+  }
+  Key& in_unit(std::string u) {
+    unit = std::move(u);
+    return *this;
+  }
+  Key& values(std::vector<std::string> v) {
+    allowed = std::move(v);
+    return *this;
+  }
+  Key& gt(double v) {
+    lo = v;
+    lo_open = true;
+    return *this;
+  }
+  Key& ge(double v) {
+    lo = v;
+    lo_open = false;
+    return *this;
+  }
+  Key& lt(double v) {
+    hi = v;
+    hi_open = true;
+    return *this;
+  }
+  Key& le(double v) {
+    hi = v;
+    hi_open = false;
+    return *this;
+  }
+  Key& says(std::string m) {
+    range_message = std::move(m);
+    return *this;
+  }
+  Key& group(std::string g) {
+    one_of = std::move(g);
+    return *this;
+  }
   Key& only_when(std::string key, std::vector<std::string> vals = {}, std::string fallback = "") {
     when.push_back({std::move(key), std::move(vals), std::move(fallback)});
     return *this;
   }
-  Key& with(std::vector<Key> c) { children = std::move(c); return *this; }
-  Key& count(int n) { size = n; return *this; }
+  Key& with(std::vector<Key> c) {
+    children = std::move(c);
+    return *this;
+  }
+  Key& count(int n) {
+    size = n;
+    return *this;
+  }
 };
-
 
 // Building declarations.
 Key number(std::string name, std::string meaning);
@@ -140,9 +183,9 @@ void declare(const Key& section);
 std::vector<Key> scene_keys();
 
 struct Problem {
-  std::string where;    // "file:line:col", "file (--set key=value)", or "" when in message
+  std::string where;  // "file:line:col", "file (--set key=value)", or "" when in message
   std::string message;
-  std::string key;      // dotted key the problem is about ("" = the scene)
+  std::string key;  // dotted key the problem is about ("" = the scene)
   std::string text() const { return where.empty() ? message : where + ": " + message; }
 };
 

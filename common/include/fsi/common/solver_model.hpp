@@ -12,7 +12,6 @@
 // scene) makes it continue exactly as the saved one would have, bit for bit.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -57,27 +56,27 @@ inline Eigen::VectorXd apply_nodal(const NodalMatrix& m, const Eigen::VectorXd& 
 
 struct InterfaceMeshData {
   std::vector<std::int64_t> node_ids;
-  Eigen::MatrixX2d coordinates;                // reference configuration, n x 2
-  std::vector<std::array<int, 2>> segments;    // local indices; empty for a point interface
-  Eigen::VectorXd lumped_measure;              // used when segments is empty (size n)
-  Eigen::VectorXd initial_displacement;        // 2n, or empty = zero
-  Eigen::VectorXd initial_velocity;            // 2n, or empty = zero
-  double mass_per_area = 0;                    // a solid's m_s / |Gamma| (coupling.robin_auto); 0 = unknown
+  Eigen::MatrixX2d coordinates;              // reference configuration, n x 2
+  std::vector<std::array<int, 2>> segments;  // local indices; empty for a point interface
+  Eigen::VectorXd lumped_measure;            // used when segments is empty (size n)
+  Eigen::VectorXd initial_displacement;      // 2n, or empty = zero
+  Eigen::VectorXd initial_velocity;          // 2n, or empty = zero
+  double mass_per_area = 0;                  // a solid's m_s / |Gamma| (coupling.robin_auto); 0 = unknown
   std::size_t nodes() const { return static_cast<std::size_t>(coordinates.rows()); }
 };
 
 struct StepInfo {
-  double time = 0;   // t_{n+1}
+  double time = 0;  // t_{n+1}
   double dt = 0;
-  int step = 0;      // n+1
-  int iteration = 0; // coupling iteration k (1-based); 0 when standalone
+  int step = 0;       // n+1
+  int iteration = 0;  // coupling iteration k (1-based); 0 when standalone
 };
 
 struct SolidSetup {
   double dt = 0;
   double end_time = 0;
-  double interface_damping = 0;  // gamma_N1 for Algorithm 2, else 0
-  std::filesystem::path output_dir;  // empty = write nothing
+  double interface_damping = 0;              // gamma_N1 for Algorithm 2, else 0
+  std::filesystem::path output_dir;          // empty = write nothing
   VtkFormat vtk_format = VtkFormat::Binary;  // time.vtk_format
 };
 
@@ -143,7 +142,7 @@ struct FluidLoads {
   Eigen::VectorXd traction_force;     // f_sigma = int N^T sigma n dgamma (2n)
   Eigen::VectorXd velocity_integral;  // f_v = int N^T v_f dgamma (2n)
   int nonlinear_iterations = 0;
-  NodalMatrix interface_mass;         // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
+  NodalMatrix interface_mass;  // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
 };
 
 class FluidModel {

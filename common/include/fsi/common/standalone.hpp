@@ -38,11 +38,11 @@ int run_standalone_fluid(const FluidFactory& factory, const Scene& scene, const 
 struct TimeSettings {
   double dt = 0;
   double end = 0;
-  int steps = 0;          // round(end / dt)
-  int output_every = 0;   // write VTK every N steps (0 = never)
+  int steps = 0;                             // round(end / dt)
+  int output_every = 0;                      // write VTK every N steps (0 = never)
   VtkFormat vtk_format = VtkFormat::Binary;  // binary (zlib, appended) or ascii
-  int checkpoint_every = 0;  // coupled runs: a checkpoint every N accepted steps (0 = off)
-  int checkpoint_keep = 2;   // the newest K complete checkpoints are kept
+  int checkpoint_every = 0;                  // coupled runs: a checkpoint every N accepted steps (0 = off)
+  int checkpoint_keep = 2;                   // the newest K complete checkpoints are kept
 };
 TimeSettings read_time(const Scene& scene);
 // The declaration of the `time` section (read by read_time).
@@ -69,8 +69,8 @@ class Progress {
   int first_;
   double start_;
   double last_ = -1e9;
-  double step_start_ = 0;       // wall time at the end of the previous step (or at the start)
-  double first_done_ = -1;      // wall time at the end of the first step done here
+  double step_start_ = 0;   // wall time at the end of the previous step (or at the start)
+  double first_done_ = -1;  // wall time at the end of the first step done here
   int first_done_step_ = 0;
 };
 

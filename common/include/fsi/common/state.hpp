@@ -13,7 +13,6 @@
 // u32 name length, name, u8 type (1 vector of f64, 2 f64, 3 i64, 4 text), u64 byte length,
 // bytes. Doubles are stored as their bit patterns, so a round trip is exact.
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <map>
 #include <stdexcept>

@@ -8,7 +8,6 @@
 //    compressor vtkZLibDataCompressor); doubles exactly as in memory.
 //  - Ascii: readable text, values with 10 significant digits (points 12).
 #include <Eigen/Core>
-
 #include <filesystem>
 #include <map>
 #include <string>
@@ -19,9 +18,9 @@ namespace fsi {
 enum class VtkCellType : int { Vertex = 1, Line = 3, Triangle = 5, Quad = 9 };
 
 struct VtkGrid {
-  Eigen::MatrixXd points;                    // n x 2 or n x 3
-  std::vector<std::vector<int>> cells;       // node indices per cell
-  std::vector<VtkCellType> cell_types;       // one per cell
+  Eigen::MatrixXd points;                             // n x 2 or n x 3
+  std::vector<std::vector<int>> cells;                // node indices per cell
+  std::vector<VtkCellType> cell_types;                // one per cell
   std::map<std::string, Eigen::MatrixXd> point_data;  // n x ncomp (2 comps padded to 3)
   std::map<std::string, Eigen::MatrixXd> cell_data;   // ncells x ncomp
 };

@@ -17,7 +17,6 @@
 // options of its own, if any, are declared in coupler/src/coupling_keys.cpp.
 // Pure linear algebra: no knowledge of solvers, messages or time.
 #include <Eigen/Core>
-
 #include <functional>
 #include <memory>
 #include <string>

@@ -10,10 +10,9 @@
 //   CheckpointStore store(out_dir / "checkpoints", 2);
 //   store.write(50, 1.0, manifest_extra, {{"solid", bytes_s}, {"fluid", bytes_f}, {"coupler", bytes_c}});
 //   if (auto c = store.newest()) { ... c->parts.at("solid") ... }
-#include <nlohmann/json.hpp>
-
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>

@@ -22,7 +22,6 @@
 // Usage: Coupler c(solid, fluid, scene, out_dir); RunOutcome r = c.run();
 // The models may be in-process (tests) or remote proxies (protocol/remote.hpp).
 #include <Eigen/Core>
-
 #include <atomic>
 #include <filesystem>
 #include <functional>
@@ -38,7 +37,7 @@
 namespace fsi {
 struct TimeSettings;  // fsi/common/standalone.hpp
 class StateArchive;   // fsi/common/state.hpp
-}
+}  // namespace fsi
 
 namespace fsi::coupling {
 
@@ -49,7 +48,7 @@ struct RunOutcome {
   std::string reason;
   int steps = 0;
   long iterations = 0;
-  int resumed_from = -1;           // the checkpoint's step when resumed
+  int resumed_from = -1;  // the checkpoint's step when resumed
   int exit_code() const {
     return status == "completed" ? 0 : status == "diverged" ? 2 : status == "interrupted" ? 130 : 1;
   }
@@ -102,29 +101,29 @@ class Coupler {
   struct Update;   // what one coupling iteration gives: F^(k+1) and the residual quantities
   // 1. The scene's time and coupling sections; both solvers configured, the interface map.
   TimeSettings configure(InterfaceMeshData& fluid_interface);
-  void automatic_robin(const TimeSettings& time);      // coupling.robin_auto: gamma from the solid's mass
+  void automatic_robin(const TimeSettings& time);  // coupling.robin_auto: gamma from the solid's mass
   // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
   void describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface);
   // 2. The state the first step starts from: a checkpoint (resume, fork) or the initial one.
   void start_state(Run& r);
-  void find_restart(Run& r);                           // --resume's checkpoint, forked_from.json
-  void load_restart(Run& r);                           // both solvers' and the coupler's parts
+  void find_restart(Run& r);  // --resume's checkpoint, forked_from.json
+  void load_restart(Run& r);  // both solvers' and the coupler's parts
   void read_coupler_state(Run& r, const StateArchive& c);
   void convert_forked_predictor(Run& r, const StateArchive& c);  // forked into another algorithm / gamma_N1
-  void initial_state(Run& r);                          // F_0 = -F*(initial fluid state)
+  void initial_state(Run& r);                                    // F_0 = -F*(initial fluid state)
   // probes.csv, iterations.csv and timing.csv: new, or continued after the checkpoint.
   void open_tables(Run& r);
   // 3. One step: its iterations, then accept.
   Step begin_step(Run& r, int n);
-  Update coupling_iteration(Run& r, Step& step);       // solid, fluid, F*, residual, F^(k+1)
-  Update parallel_iteration(Run& r, Step& step);       // solid and fluid at once, x^(k+1)
+  Update coupling_iteration(Run& r, Step& step);  // solid, fluid, F*, residual, F^(k+1)
+  Update parallel_iteration(Run& r, Step& step);  // solid and fluid at once, x^(k+1)
   void stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force);
-  double parallel_gap_limit() const;                   // the interface state's convergence limit
+  double parallel_gap_limit() const;                     // the interface state's convergence limit
   bool measures_met(Step& step, const Update& u) const;  // the convergence measures
   // The iteration's row in iterations.csv, F^(k+1); throws on divergence; true when converged.
   bool finish_iteration(Run& r, Step& step, const Update& u, bool met);
-  void check_unconverged(const Step& step) const;      // strict measures, stop_if_not_converged
-  void accept_step(Run& r, Step& step);                // accept calls, probes, output, checkpoint
+  void check_unconverged(const Step& step) const;  // strict measures, stop_if_not_converged
+  void accept_step(Run& r, Step& step);            // accept calls, probes, output, checkpoint
   void interface_balance(Run& r, const Iterate& last, std::map<std::string, double>& row);
   void save_checkpoint(Run& r, int n, double t_np1);
   // H^T M_f H of a fluid solve (empty when the fluid does not send M_f).

@@ -17,7 +17,6 @@
 // projections on the solid polyline, within gap / segment length of P's unit rows).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <string>
 
 #include "fsi/common/solver_model.hpp"
@@ -74,7 +73,7 @@ class InterfaceMap {
   void set_from_scalar(const Eigen::MatrixXd& hs);
   Eigen::SparseMatrix<double> h_, ht_;
   Eigen::SparseMatrix<double> hs_, hst_;  // the scalar (per node) H, n_f x n_s, and its transpose
-  Eigen::MatrixXd hs_dense_;               // RBF: the same, dense (empty for the projection)
+  Eigen::MatrixXd hs_dense_;              // RBF: the same, dense (empty for the projection)
   double max_gap_ = 0;
   bool conforming_ = false;
   Eigen::Index coincident_nodes_ = 0;

@@ -9,7 +9,6 @@
 //          traction_force, velocity_integral (what the fluid sent, before mapping)
 // Comparing sum(force) on both sides, or the fields in ParaView, checks a mapping.
 #include <Eigen/Core>
-
 #include <filesystem>
 
 #include "fsi/common/solver_model.hpp"
@@ -18,16 +17,16 @@
 namespace fsi::coupling {
 
 struct InterfaceFields {
-  Eigen::VectorXd solid_displacement, solid_velocity, solid_force;         // 2 n_s each
-  Eigen::VectorXd traction_mapped, velocity_integral_mapped;               // 2 n_s each
-  Eigen::VectorXd fluid_displacement, fluid_velocity;                      // 2 n_f each
-  Eigen::VectorXd traction_force, velocity_integral;                       // 2 n_f each
+  Eigen::VectorXd solid_displacement, solid_velocity, solid_force;  // 2 n_s each
+  Eigen::VectorXd traction_mapped, velocity_integral_mapped;        // 2 n_s each
+  Eigen::VectorXd fluid_displacement, fluid_velocity;               // 2 n_f each
+  Eigen::VectorXd traction_force, velocity_integral;                // 2 n_f each
 };
 
 class InterfaceOutput {
  public:
-  InterfaceOutput(const std::filesystem::path& vtk_dir, const InterfaceMeshData& solid,
-                  const InterfaceMeshData& fluid, VtkFormat format = VtkFormat::Binary);
+  InterfaceOutput(const std::filesystem::path& vtk_dir, const InterfaceMeshData& solid, const InterfaceMeshData& fluid,
+                  VtkFormat format = VtkFormat::Binary);
   void write(double time, int step, const InterfaceFields& fields);
 
  private:

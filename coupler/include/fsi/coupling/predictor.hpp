@@ -10,7 +10,6 @@
 // kept fewer), the highest degree the history allows. A new predictor is one line in the
 // registry (predictor.cpp).
 #include <Eigen/Core>
-
 #include <string>
 #include <vector>
 

@@ -34,7 +34,7 @@ struct ConvergenceMeasure {
   MeasureQuantity quantity = MeasureQuantity::Force;
   MeasureType type = MeasureType::Relative;
   double limit = 1e-4;
-  bool strict = false;  // not met in k_max iterations = the run diverged
+  bool strict = false;       // not met in k_max iterations = the run diverged
   std::string name() const;  // e.g. "traction_relative" (its iterations.csv column)
 };
 
@@ -74,13 +74,13 @@ struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
   CouplingScheme scheme = CouplingScheme::Serial;
   RobinAuto robin_auto = RobinAuto::None;
-  double nitsche_penalty = 0;     // gamma_N1 >= 0
+  double nitsche_penalty = 0;  // gamma_N1 >= 0
   // The fluid's Nitsche penalty gamma_f (its weak no-slip v_f = v_s on the interface). The
   // paper uses one parameter: gamma_f = gamma_N1 (the default). Set apart, the converged
   // coupled solution no longer depends on the Robin parameter gamma_N1 of Algorithm 2.
   double fluid_penalty = 0;
-  double nitsche_symmetry = -1;   // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
-  double relaxation = 1;          // beta in (0, 1]
+  double nitsche_symmetry = -1;  // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
+  double relaxation = 1;         // beta in (0, 1]
   // F^(1)_{n+1} from the accepted forces: a name of predictor.hpp's registry ("previous" =
   // F_n, the paper).
   std::string predictor = "previous";
@@ -88,15 +88,15 @@ struct CouplingSettings {
   // the paper's beta; Aitken and the quasi-Newton schemes are beyond the paper and start each
   // step with beta).
   std::string acceleration = "constant";
-  int reuse_steps = 8;            // quasi-Newton: secant pairs of the last N accepted steps are reused
-  double iqn_filter = 1e-3;       // quasi-Newton: the filter's limit eps
+  int reuse_steps = 8;       // quasi-Newton: secant pairs of the last N accepted steps are reused
+  double iqn_filter = 1e-3;  // quasi-Newton: the filter's limit eps
   QrFilter iqn_filter_type = QrFilter::Qr2;
   Preconditioner iqn_preconditioner = Preconditioner::None;
   ImvjRestart imvj_restart = ImvjRestart::None;
-  int imvj_chunk_size = 8;            // restart after this many steps
-  int imvj_restart_reuse_steps = 8;   // rs-ls: the steps whose secant pairs define the restart
-  double imvj_truncation = 1e-4;      // rs-svd: relative truncation of the singular values
-  int max_iterations = 1;         // k_max
+  int imvj_chunk_size = 8;           // restart after this many steps
+  int imvj_restart_reuse_steps = 8;  // rs-ls: the steps whose secant pairs define the restart
+  double imvj_truncation = 1e-4;     // rs-svd: relative truncation of the singular values
+  int max_iterations = 1;            // k_max
   // 0: exactly max_iterations iterations per step (the paper). > 0: iterate until the
   // relative interface residual ||F^(k+1) - F^(k)|| / ||F^(k+1)|| is below it.
   double tolerance = 0;
@@ -108,7 +108,7 @@ struct CouplingSettings {
   // iterations.measures (or, without it, iterations.tolerance as {force, relative}); empty =
   // always k_max iterations (the paper).
   std::vector<ConvergenceMeasure> measures;
-  bool combine_all = true;            // iterations.combine: all measures must hold, or any
+  bool combine_all = true;  // iterations.combine: all measures must hold, or any
   // coupling.mapping (and coupling.support_radius): how interface values move between the
   // solid's and the fluid's nodes (interface_map.hpp).
   MappingSettings mapping;

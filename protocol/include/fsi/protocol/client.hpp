@@ -15,8 +15,7 @@ constexpr std::uint32_t kProtocolVersion = fsi::v1::PROTOCOL_VERSION_CURRENT;
 // The peer answered with an Error reply, or with something that is not a valid reply.
 class RemoteError : public std::runtime_error {
  public:
-  RemoteError(fsi::v1::Error::Code code, const std::string& message)
-      : std::runtime_error(message), code_(code) {}
+  RemoteError(fsi::v1::Error::Code code, const std::string& message) : std::runtime_error(message), code_(code) {}
   fsi::v1::Error::Code code() const { return code_; }
 
  private:
@@ -26,8 +25,7 @@ class RemoteError : public std::runtime_error {
 class ProtocolClient {
  public:
   ProtocolClient(const std::string& endpoint, std::string peer_name,
-                 std::chrono::milliseconds timeout = std::chrono::minutes(10),
-                 const transport::CurveKeys& keys = {});
+                 std::chrono::milliseconds timeout = std::chrono::minutes(10), const transport::CurveKeys& keys = {});
   // Sends `request` (version and sequence are filled in) and returns the reply.
   // Throws transport::TransportError (timeout, lost peer) or RemoteError.
   fsi::v1::Reply call(fsi::v1::Request request);

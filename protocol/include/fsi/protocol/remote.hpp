@@ -9,8 +9,8 @@
 namespace fsi::protocol {
 
 struct RemoteTimes {
-  double wall = 0;       // seconds inside calls
-  double compute = 0;    // seconds the server reported computing
+  double wall = 0;     // seconds inside calls
+  double compute = 0;  // seconds the server reported computing
   double messaging() const { return wall > compute ? wall - compute : 0.0; }
 };
 

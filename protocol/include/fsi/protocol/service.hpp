@@ -18,8 +18,7 @@ class Service {
  public:
   virtual ~Service() = default;
   // `peer` identifies the client's connection (transport); "" = the only client.
-  std::string handle_bytes(const std::string& request_bytes, bool& stop,
-                           const std::string& peer = "");
+  std::string handle_bytes(const std::string& request_bytes, bool& stop, const std::string& peer = "");
   fsi::v1::Reply handle(const fsi::v1::Request& request, bool& stop, const std::string& peer = "");
   // The connection of `peer` closed: its session, if it holds one, ends and the server
   // forgets its configuration (the next coupler configures it again).
@@ -76,8 +75,7 @@ class FluidService : public Service {
 // Binds `endpoint`, writes the bound endpoint to `port_file` (if non-empty, atomically),
 // and serves until Stop, idle timeout, or SIGINT/SIGTERM. Returns the process exit code.
 // With CURVE `keys`, only authorised clients can connect.
-int run_server(Service& service, const std::string& endpoint, const std::string& port_file,
-               double idle_timeout_seconds, const std::string& log_name,
-               const transport::CurveKeys& keys = {});
+int run_server(Service& service, const std::string& endpoint, const std::string& port_file, double idle_timeout_seconds,
+               const std::string& log_name, const transport::CurveKeys& keys = {});
 
 }  // namespace fsi::protocol

@@ -86,8 +86,7 @@ class Server {
 
   // Handler returns the reply bytes; set `stop` to end serving after this reply. `peer`
   // identifies the connection the request came from (opaque bytes, stable while it lasts).
-  using Handler =
-      std::function<std::string(const std::string& request, const std::string& peer, bool& stop)>;
+  using Handler = std::function<std::string(const std::string& request, const std::string& peer, bool& stop)>;
   // Serves requests until a handler sets stop, or no request arrives for `idle_timeout`
   // (zero = wait forever), or `should_stop()` returns true (polled every 200 ms).
   // Returns false on idle timeout.

@@ -9,7 +9,6 @@
 // triangle; how many did, and how far, is reported.
 // Pure geometry and interpolation: no solver, no I/O.
 #include <Eigen/Core>
-
 #include <vector>
 
 #include "fsi/fluid/mesh.hpp"
@@ -39,8 +38,8 @@ class MeshLocator {
 
 struct TransferReport {
   int points = 0;
-  int outside = 0;            // points not inside any source triangle
-  double max_distance = 0;    // the farthest of them from the source mesh
+  int outside = 0;          // points not inside any source triangle
+  double max_distance = 0;  // the farthest of them from the source mesh
 };
 
 // The values at `points` of a nodal field of the source mesh: `field` has one row per source

@@ -21,7 +21,6 @@
 // per step is the second-order semi-implicit scheme (one factorisation per step).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <functional>
 #include <memory>
 #include <string>
@@ -60,8 +59,8 @@ struct FlowParameters {
   double density = 1.0;
   double viscosity = 1e-3;  // dynamic
   TimeScheme scheme = TimeScheme::BDF2;
-  int max_iterations = 1;   // nonlinear solves per step
-  double tolerance = 1e-10; // stop when the relative velocity change falls below
+  int max_iterations = 1;    // nonlinear solves per step
+  double tolerance = 1e-10;  // stop when the relative velocity change falls below
   // Newton: the exact Jacobian of the Galerkin convection term ((du . grad) u_k added to the
   // Oseen operator); false: Picard (Oseen) iterations. The first solve of a time step always
   // advects with the extrapolated velocity, so max_iterations = 1 is the semi-implicit scheme.
@@ -97,7 +96,7 @@ struct FlowParameters {
 
 struct StepReport {
   int iterations = 0;
-  double change = 0;           // last relative velocity change
+  double change = 0;  // last relative velocity change
   double assembly_seconds = 0;
   double factor_seconds = 0;
   double solve_seconds = 0;
@@ -126,7 +125,8 @@ class FlowSolver {
   // Solves time level `time` (= t_n + dt) from the accepted state, on the mesh at `positions`
   // (every node, current configuration), with the interface velocity per interface node
   // (interleaved, 2 * interface_nodes().size(); empty = zero). Repeatable before accept().
-  StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity);
+  StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions,
+                   const Eigen::VectorXd& interface_velocity);
   void accept();
 
   // --- checkpoints (after accept()) ---

@@ -8,7 +8,6 @@
 // `triangles` holds the three vertices, `edge_nodes(e, k)` the node of edge (k, k+1 mod 3),
 // and every boundary segment (a, b) has its midpoint in `boundary_midpoints`.
 #include <Eigen/Core>
-
 #include <map>
 #include <string>
 #include <vector>
@@ -21,12 +20,12 @@ using IndexMatrix3 = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using IndexMatrix2 = Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor>;
 
 struct FluidMesh {
-  Eigen::MatrixX2d nodes;                         // reference positions
-  IndexMatrix3 triangles;                         // counter-clockwise
+  Eigen::MatrixX2d nodes;                          // reference positions
+  IndexMatrix3 triangles;                          // counter-clockwise
   std::map<std::string, IndexMatrix2> boundaries;  // named segment groups (vertex pairs)
   // Quadratic meshes only (empty otherwise):
-  int vertex_count = -1;                                    // -1: every node is a vertex (linear mesh)
-  IndexMatrix3 edge_nodes;                                  // midpoint of edge (k, k+1) of each triangle
+  int vertex_count = -1;                                      // -1: every node is a vertex (linear mesh)
+  IndexMatrix3 edge_nodes;                                    // midpoint of edge (k, k+1) of each triangle
   std::map<std::string, Eigen::VectorXi> boundary_midpoints;  // midpoint of each segment of a group
 
   bool quadratic() const { return edge_nodes.rows() > 0; }

@@ -15,7 +15,6 @@
 //   Eigen::MatrixX2d x = mesh.nodes + motion.extend(interface_displacement);  // any iteration
 //   motion.accept(interface_displacement);                                     // step accepted
 #include <Eigen/Core>
-
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,8 +27,8 @@ namespace fsi::fluid {
 struct MeshMotionOptions {
   enum class Method { Harmonic, Elastic };
   Method method = Method::Harmonic;
-  double stiffening = 1.0;   // exponent of (A_mean / A_e)
-  bool incremental = false;  // rebuild the operator on the deformed mesh after each step
+  double stiffening = 1.0;     // exponent of (A_mean / A_e)
+  bool incremental = false;    // rebuild the operator on the deformed mesh after each step
   double poisson_ratio = 0.3;  // elastic only
 };
 
@@ -38,7 +37,8 @@ class MeshMotion {
   MeshMotion(const FluidMesh& mesh, std::vector<int> moving_nodes, std::vector<int> fixed_nodes,
              MeshMotionOptions options = {});
   MeshMotion(const FluidMesh& mesh, std::vector<int> moving_nodes, std::vector<int> fixed_nodes, double stiffening)
-      : MeshMotion(mesh, std::move(moving_nodes), std::move(fixed_nodes), MeshMotionOptions{MeshMotionOptions::Method::Harmonic, stiffening, false}) {}
+      : MeshMotion(mesh, std::move(moving_nodes), std::move(fixed_nodes),
+                   MeshMotionOptions{MeshMotionOptions::Method::Harmonic, stiffening, false}) {}
   ~MeshMotion();
   // Displacement of every node from the reference mesh (n x 2) for the moving nodes' total
   // displacement from the reference (interleaved x, y).

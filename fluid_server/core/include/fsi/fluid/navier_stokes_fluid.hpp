@@ -6,8 +6,8 @@
 //
 // Call order (fsi::FluidModel): configure -> interface -> {solve_step ... accept_step} -> write_output.
 #include <chrono>
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -68,8 +68,10 @@ class NavierStokesFluid : public FluidModel {
   // Cumulative seconds: "mesh_motion" (extension), "assembly", "factorisation", "linear_solve"
   // (triangular solves and Krylov iterations), "step" (all of them, per solve call).
   std::map<std::string, double> timings() const override {
-    std::map<std::string, double> t{{"mesh_motion", motion_ ? motion_->seconds() : 0.0}, {"assembly", assembly_seconds_},
-                                    {"factorisation", factor_seconds_}, {"linear_solve", linear_solve_seconds_},
+    std::map<std::string, double> t{{"mesh_motion", motion_ ? motion_->seconds() : 0.0},
+                                    {"assembly", assembly_seconds_},
+                                    {"factorisation", factor_seconds_},
+                                    {"linear_solve", linear_solve_seconds_},
                                     {"step", solve_seconds_}};
     if (remeshes_ > 0) t["remesh"] = remesh_seconds_, t["remeshes"] = remeshes_;  // "remeshes": a count
     return t;
@@ -103,9 +105,9 @@ class NavierStokesFluid : public FluidModel {
   // Remeshing (fluid.remesh; remesh.hpp).
   struct RemeshSettings {
     bool enabled = false;
-    double min_quality = 0.1;           // remesh when the minimum scaled Jacobian falls below
+    double min_quality = 0.1;          // remesh when the minimum scaled Jacobian falls below
     double min_curved_jacobian = 0.3;  // P2: or the curved Jacobian (relative) below
-    std::vector<int> at_steps;          // forced remeshes after these steps (tests)
+    std::vector<int> at_steps;         // forced remeshes after these steps (tests)
   } remesh_;
   void read_remesh(const schema::Reader& section, bool moving);
   void remesh(const StepInfo& info, const std::string& why);
@@ -117,10 +119,10 @@ class NavierStokesFluid : public FluidModel {
   std::vector<std::function<void(FlowSolver&)>> conditions_;  // the scene's conditions, for a new solver
   std::vector<std::string> interface_groups_, fixed_groups_;
   MeshMotionOptions motion_options_;
-  FluidMesh original_mesh_;                 // the scene's mesh (checkpoints from before a remesh)
-  Eigen::VectorXd remesh_offset_;           // the interface displacement at the last remesh
-  double remesh_quality_ = 1.0;             // the quality the last remesh reached
-  Eigen::VectorXd remesh_size_;             // the target size per vertex (the scene mesh's, carried on)
+  FluidMesh original_mesh_;        // the scene's mesh (checkpoints from before a remesh)
+  Eigen::VectorXd remesh_offset_;  // the interface displacement at the last remesh
+  double remesh_quality_ = 1.0;    // the quality the last remesh reached
+  Eigen::VectorXd remesh_size_;    // the target size per vertex (the scene mesh's, carried on)
   int remeshes_ = 0;
   double remesh_seconds_ = 0;
   Eigen::VectorXd motion_input(const Eigen::VectorXd& interface_displacement) const;
@@ -136,7 +138,7 @@ class NavierStokesFluid : public FluidModel {
   double assembly_seconds_ = 0, factor_seconds_ = 0, linear_solve_seconds_ = 0;
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
-  int factorisations_ = 0;  // cumulative
+  int factorisations_ = 0;                       // cumulative
   Eigen::VectorXd last_interface_displacement_;  // of the last solve (for the mesh motion's accept)
 };
 

@@ -20,7 +20,7 @@
 namespace fsi::fluid {
 
 struct ElementInput {
-  Eigen::Matrix<double, 3, 2> x;        // node positions (current configuration)
+  Eigen::Matrix<double, 3, 2> x;          // node positions (current configuration)
   Eigen::Matrix<double, 3, 2> advection;  // a = u* - w at the nodes
   Eigen::Matrix<double, 3, 2> history;    // (alpha1 u_n + alpha2 u_{n-1}) / dt at the nodes (0 if steady)
   Eigen::Matrix<double, 3, 2> force;      // body force f at the nodes

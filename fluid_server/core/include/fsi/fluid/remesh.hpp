@@ -13,7 +13,6 @@
 // interface) keep their order and their segments: an interface mapping built on the old mesh
 // stays valid. Boundary groups are carried over.
 #include <Eigen/Core>
-
 #include <vector>
 
 #include "fsi/fluid/mesh.hpp"
@@ -21,10 +20,10 @@
 namespace fsi::fluid {
 
 struct RemeshResult {
-  FluidMesh mesh;             // its reference positions are the old mesh's current ones
-  std::vector<int> old_node;  // per new node: the old node it is (kept boundary nodes), or -1
+  FluidMesh mesh;               // its reference positions are the old mesh's current ones
+  std::vector<int> old_node;    // per new node: the old node it is (kept boundary nodes), or -1
   Eigen::VectorXd vertex_size;  // the target size at every new vertex (interpolated from the old one)
-  double seconds = 0;         // wall time in gmsh and the renumbering
+  double seconds = 0;           // wall time in gmsh and the renumbering
 };
 
 // `positions`: the old mesh's nodes where they are now (node_count x 2). Throws

@@ -28,7 +28,6 @@
 //   x = lu.solve(A, b, guess, report, "fluid step at t = 0.1");   // same pattern every call
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <memory>
 #include <string>
 #include <utility>

@@ -3,14 +3,13 @@
 // Node order counter-clockwise; dofs interleaved [x0, y0, x1, y1, ...].
 // Kernels take and return Eigen types; no I/O.
 #include <Eigen/Core>
-
 #include <array>
 
 #include "fsi/solid/material.hpp"
 
 namespace fsi::solid {
 
-using ElementCoords = Eigen::Matrix<double, 4, 2>;   // reference coordinates X, row per node
+using ElementCoords = Eigen::Matrix<double, 4, 2>;  // reference coordinates X, row per node
 using ElementVector = Eigen::Matrix<double, 8, 1>;
 using ElementMatrix = Eigen::Matrix<double, 8, 8>;
 
@@ -25,10 +24,10 @@ Eigen::Matrix<double, 4, 2> q4_shape_derivatives(double xi, double eta);  // dN/
 std::vector<std::array<double, 3>> gauss_rule_2d(int n);
 
 struct ElementState {
-  ElementVector internal_force = ElementVector::Zero();   // int B^T S dV
-  ElementMatrix tangent = ElementMatrix::Zero();          // material + geometric
-  double min_det_F = 1;                                    // over the Gauss points
-  double min_det_jacobian = 1;                             // of the reference map
+  ElementVector internal_force = ElementVector::Zero();  // int B^T S dV
+  ElementMatrix tangent = ElementMatrix::Zero();         // material + geometric
+  double min_det_F = 1;                                  // over the Gauss points
+  double min_det_jacobian = 1;                           // of the reference map
 };
 
 // Internal force and consistent tangent for displacement u (8). When `with_tangent` is

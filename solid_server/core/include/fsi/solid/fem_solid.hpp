@@ -18,7 +18,6 @@
 // analysis (equilibrium with the full load in `load_steps` increments per step).
 // The scene keys are documented in configs/csm1.yaml and docs/solid.md.
 #include <Eigen/Core>
-
 #include <memory>
 #include <optional>
 
@@ -79,15 +78,15 @@ class FemSolid : public fsi::SolidModel {
   TimeScheme scheme_ = TimeScheme::Static;
   int load_steps_ = 1;
   NewtonOptions newton_;
-  Eigen::VectorXd dead_load_;            // gravity + edge tractions
-  std::vector<int> interface_nodes_;     // global node ids
+  Eigen::VectorXd dead_load_;         // gravity + edge tractions
+  std::vector<int> interface_nodes_;  // global node ids
   InterfaceMeshData interface_;
   std::vector<Probe> probes_;
   int output_every_ = 1;
   std::optional<PvdSeries> series_;
   // Accepted (n) and trial (n+1) states.
   Eigen::VectorXd d_n_, v_n_, a_n_, f_n_;
-  Eigen::VectorXd d_nm1_, v_nm1_;        // step n-1 (bdf2), valid once accepted_steps_ >= 1
+  Eigen::VectorXd d_nm1_, v_nm1_;  // step n-1 (bdf2), valid once accepted_steps_ >= 1
   int accepted_steps_ = 0;
   Eigen::VectorXd d_, v_, a_, f_;
   int last_iterations_ = 0;

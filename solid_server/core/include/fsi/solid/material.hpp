@@ -8,7 +8,6 @@
 // Kernels take and return Eigen types; no I/O.
 #include <Eigen/Core>
 #include <Eigen/LU>
-
 #include <memory>
 #include <string>
 

@@ -1,7 +1,6 @@
 #pragma once
 // Solid meshes: Q4 cells and named edge sets (for clamps, interfaces and loads).
 #include <Eigen/Core>
-
 #include <array>
 #include <map>
 #include <string>
@@ -14,8 +13,8 @@ struct GmshMesh;
 namespace fsi::solid {
 
 struct SolidMesh {
-  Eigen::MatrixX2d nodes;                     // reference coordinates
-  std::vector<std::array<int, 4>> cells;      // counter-clockwise Q4
+  Eigen::MatrixX2d nodes;                                            // reference coordinates
+  std::vector<std::array<int, 4>> cells;                             // counter-clockwise Q4
   std::map<std::string, std::vector<std::array<int, 2>>> edge_sets;  // boundary edges by name
 
   int num_nodes() const { return static_cast<int>(nodes.rows()); }

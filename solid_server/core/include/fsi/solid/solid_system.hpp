@@ -13,7 +13,6 @@
 // refactorises numerically only.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <array>
 #include <functional>
 #include <memory>
@@ -50,21 +49,21 @@ class SparseDirectSolver {
 };
 
 struct TimeTerms {
-  double mass_coefficient = 0;     // c_a: a = c_a d + a_hist
-  double damping_coefficient = 0;  // c_v: v = c_v d + v_hist
+  double mass_coefficient = 0;           // c_a: a = c_a d + a_hist
+  double damping_coefficient = 0;        // c_v: v = c_v d + v_hist
   Eigen::VectorXd acceleration_history;  // a_hist (empty = 0)
   Eigen::VectorXd velocity_history;      // v_hist (empty = 0)
 };
 
 struct NewtonOptions {
   int max_iterations = 25;
-  double residual_tolerance = 1e-8;   // ||R_k|| <= tol * max(||R_0||, ||F_ext||)
-  double increment_tolerance = 1e-10; // ||dd|| <= tol * ||d||
+  double residual_tolerance = 1e-8;    // ||R_k|| <= tol * max(||R_0||, ||F_ext||)
+  double increment_tolerance = 1e-10;  // ||dd|| <= tol * ||d||
 };
 
 struct NewtonReport {
   int iterations = 0;
-  double residual = 0;      // last ||R|| (free dofs)
+  double residual = 0;  // last ||R|| (free dofs)
   double initial_residual = 0;
   bool converged = false;
 };
@@ -108,8 +107,8 @@ class SolidSystem {
   // Full residual R(d) (all dofs; on fixed dofs it is the reaction with opposite sign).
   Eigen::VectorXd residual(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t) const;
   // Tangent on the free dofs: K(d) + c_a M + c_v C, and the free part of the residual.
-  void assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t,
-                SparseMatrix& tangent, Eigen::VectorXd& residual_free) const;
+  void assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ext, const TimeTerms& t, SparseMatrix& tangent,
+                Eigen::VectorXd& residual_free) const;
 
   // Newton on the free dofs; d holds the prescribed values on fixed dofs and the initial
   // guess elsewhere. Does not throw on non-convergence (see the report); throws
@@ -127,7 +126,7 @@ class SolidSystem {
   Eigen::Matrix<double, 8, 1> cell_values(int cell, const Eigen::VectorXd& d) const;
 
  private:
-  int position(int row, int col) const;  // value index in the full pattern (throws outside it)
+  int position(int row, int col) const;       // value index in the full pattern (throws outside it)
   int find_position(int row, int col) const;  // -1 outside the pattern
   // (Re)builds pattern_, the reduced pattern, the value maps and mass_ with the cells' entries
   // plus `extra` (global dof pairs).
@@ -136,11 +135,11 @@ class SolidSystem {
   std::shared_ptr<const Material> material_;
   double density_;
   std::vector<char> fixed_;
-  std::vector<int> equation_;     // dof -> free equation or -1
-  std::vector<int> free_dofs_;    // equation -> dof
-  SparseMatrix pattern_;          // full pattern (values zero)
-  SparseMatrix mass_, damping_;   // full, on pattern_
-  SparseMatrix reduced_pattern_;  // free x free
+  std::vector<int> equation_;         // dof -> free equation or -1
+  std::vector<int> free_dofs_;        // equation -> dof
+  SparseMatrix pattern_;              // full pattern (values zero)
+  SparseMatrix mass_, damping_;       // full, on pattern_
+  SparseMatrix reduced_pattern_;      // free x free
   std::vector<int> full_to_reduced_;  // value index map, -1 for fixed rows/cols
   std::vector<int> cell_positions_;   // 64 per cell: full value index
   SparseDirectSolver solver_;
