@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages this project needs, only those missing. Idempotent.
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build git pkg-config
+  build-essential cmake ninja-build git pkg-config clang-format
   libeigen3-dev libsuitesparse-dev zlib1g-dev libopenblas0-pthread
   libprotobuf-dev protobuf-compiler libzmq3-dev cppzmq-dev
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libgtest-dev
