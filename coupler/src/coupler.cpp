@@ -801,18 +801,25 @@ Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
   }
   if (!all_finite(u.relaxed))
     throw Stop{"diverged", fmt::format("non-finite interface force at step {} iteration {}", n, k)};
+  measure(step, u, traction_change);
+  return u;
+}
+
+// The iteration's residual quantities (force change, traction mismatch, displacement and
+// velocity change) and their sizes, for the convergence measures and iterations.csv.
+void Coupler::measure(Step& step, Update& u, const Eigen::VectorXd& traction_change) const {
+  const SolidStepResult& s = u.iterate.s;
   u.norm = u.relaxed.norm();
   u.change = (u.relaxed - step.force).norm();
   step.residual = u.change / std::max(u.norm, settings_.residual_floor);
   const double r_quantity[4] = {u.change, traction_change.norm(), (s.interface_displacement - step.d_iter_prev).norm(),
                                 (s.interface_velocity - step.v_iter_prev).norm()};
-  const double q_quantity[4] = {u.norm, it.traction.norm(), s.interface_displacement.norm(),
+  const double q_quantity[4] = {u.norm, u.iterate.traction.norm(), s.interface_displacement.norm(),
                                 s.interface_velocity.norm()};
   std::copy(r_quantity, r_quantity + 4, u.r_quantity);
   std::copy(q_quantity, q_quantity + 4, u.q_quantity);
   step.d_iter_prev = s.interface_displacement;
   step.v_iter_prev = s.interface_velocity;
-  return u;
 }
 
 double Coupler::parallel_gap_limit() const {
@@ -876,18 +883,8 @@ Coupler::Update Coupler::parallel_iteration(Run& r, Step& step) {
   }
   if (!all_finite(u.relaxed) || !all_finite(u.next_d) || !all_finite(u.next_v))
     throw Stop{"diverged", fmt::format("non-finite interface state at step {} iteration {}", n, k)};
-  u.norm = u.relaxed.norm();
-  u.change = (u.relaxed - step.force).norm();
-  step.residual = u.change / std::max(u.norm, settings_.residual_floor);
+  measure(step, u, traction_change);
   u.gap = (u.next_d - step.x_d).norm() / std::max(u.next_d.norm(), settings_.residual_floor);
-  const double r_quantity[4] = {u.change, traction_change.norm(), (s.interface_displacement - step.d_iter_prev).norm(),
-                                (s.interface_velocity - step.v_iter_prev).norm()};
-  const double q_quantity[4] = {u.norm, it.traction.norm(), s.interface_displacement.norm(),
-                                s.interface_velocity.norm()};
-  std::copy(r_quantity, r_quantity + 4, u.r_quantity);
-  std::copy(q_quantity, q_quantity + 4, u.q_quantity);
-  step.d_iter_prev = s.interface_displacement;
-  step.v_iter_prev = s.interface_velocity;
   return u;
 }
 

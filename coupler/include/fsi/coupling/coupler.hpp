@@ -118,6 +118,7 @@ class Coupler {
   Update coupling_iteration(Run& r, Step& step);  // solid, fluid, F*, residual, F^(k+1)
   Update parallel_iteration(Run& r, Step& step);  // solid and fluid at once, x^(k+1)
   void stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force);
+  void measure(Step& step, Update& u, const Eigen::VectorXd& traction_change) const;  // residual quantities
   double parallel_gap_limit() const;                     // the interface state's convergence limit
   bool measures_met(Step& step, const Update& u) const;  // the convergence measures
   // The iteration's row in iterations.csv, F^(k+1); throws on divergence; true when converged.
