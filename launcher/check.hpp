@@ -1,16 +1,23 @@
 #pragma once
-// `fsi check`: a scene (or a study's scene with its fixed and varied keys) against the scene
-// schema, in-process, without meshing or starting a solver (fsi/common/scene_schema.hpp).
+// `fsi check`: a scene against the scene schema, in-process, without meshing or starting a solver
+// (fsi/common/scene_schema.hpp).
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fsi::launcher {
 
-// `fsi check FILE [--set k=v ...]`: prints "OK: FILE (N keys checked)" on stdout and returns 0,
-// or prints every problem as "file:line:col: message" on stderr and returns 1. FILE is a scene,
-// or a study (top-level `study` or `vary`): its scene with `fixed` as overrides, and every
-// scene key it varies (`vary`, `zip`, `derived`).
-int check_file(const std::string& file, const std::vector<std::string>& overrides);
+// `fsi check SCENE [--set k=v ...]`: prints "OK: SCENE (N keys checked)" on stdout and returns 0,
+// or prints every problem as "file:line:col: message" on stderr and returns 1. `placed`: overrides
+// ("key=value") with the place they were written ("file:line:col"), named in the problems (the
+// study tool checks a study's cases this way). `json`: one JSON object on stdout instead
+// ({"file", "keys_checked", "problems": [{"where", "message", "key", "text"}]}). A study is
+// read by the study tool (fsi_study.py check), not here.
+int check_file(const std::string& file, const std::vector<std::string>& overrides,
+               const std::vector<std::pair<std::string, std::string>>& placed = {}, bool json = false);
+
+// A study file (top-level `study` or `vary`) rather than a scene.
+bool is_study_file(const std::string& file);
 
 // The check `fsi run` does first: prints the problems on stderr, returns false if any (and
 // them, one a line, in `problems`). `skip_sections`: sections an external solver

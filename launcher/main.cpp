@@ -670,10 +670,10 @@ std::string python_interpreter() {
 #endif
 }
 
-// `fsi study`: hands the sweep to the study tool (tools/fsi_study.py) with every option after
-// the study file passed on unchanged, and this executable as --fsi so every run uses the same
-// build. Replaces this process; returns only on failure.
-int study(const std::vector<std::string>& study_args) {
+// `fsi study` / `fsi list`: hands over to the study tool (tools/fsi_study.py SUBCOMMAND) with every
+// option passed on unchanged; a sweep also gets this executable as --fsi so every run uses the
+// same build. Replaces this process; returns only on failure.
+int study_tool(const std::string& subcommand, const std::vector<std::string>& tool_args) {
   // An installed fsi (PREFIX/bin) uses its own copy (PREFIX/share/fsi/tools, `cmake --install`),
   // a build tree the sources it was built from.
   fs::path tool = (self_dir() / ".." / "share" / "fsi" / "tools" / "fsi_study.py").lexically_normal();
@@ -687,9 +687,9 @@ int study(const std::vector<std::string>& study_args) {
   }
   fsi::logger("fsi")->debug("study tool: {}", tool.string());
   const std::string self = fs::read_symlink("/proc/self/exe").string();
-  std::vector<std::string> args{python_interpreter(), tool.string(), "run"};
-  args.insert(args.end(), study_args.begin(), study_args.end());
-  args.insert(args.end(), {"--fsi", self});
+  std::vector<std::string> args{python_interpreter(), tool.string(), subcommand};
+  args.insert(args.end(), tool_args.begin(), tool_args.end());
+  if (subcommand == "run" || subcommand == "check") args.insert(args.end(), {"--fsi", self});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -741,7 +741,9 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
 struct CheckOptions {
   std::string file;
   std::vector<std::string> overrides;
+  std::vector<std::pair<std::string, std::string>> placed;
   bool reference = false;
+  bool json = false;
 };
 
 CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
@@ -751,6 +753,10 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
                          "without meshing or starting a solver: fsi check SCENE|STUDY [--set key=value ...]");
   check_cmd->add_option("file", c.file, "scene (configs/*.yaml) or study (studies/*.yaml)");
   check_cmd->add_option("--set", c.overrides, "override any scene key: dotted.key=value (repeatable)");
+  check_cmd->add_option("--set-at", c.placed,
+                        "as --set, with the place the value was written, named in the problems: --set-at "
+                        "key=value file:line:col (the study tool checks a study's cases this way)");
+  check_cmd->add_flag("--json", c.json, "a scene's problems as one JSON object on stdout");
   check_cmd->add_flag("--reference", c.reference,
                       "print the scene reference (Markdown, docs/scene-reference.md) from the schema");
   return check_cmd;
@@ -765,7 +771,12 @@ int check(const CheckOptions& c) {
     std::cerr << "fsi check: give a scene or study file (or --reference)\n";
     return 1;
   }
-  return fsi::launcher::check_file(c.file, c.overrides);
+  if (fsi::launcher::is_study_file(c.file)) {  // the study tool reads studies, and checks each case here
+    std::vector<std::string> args{c.file};
+    for (const auto& o : c.overrides) args.insert(args.end(), {"--set", o});
+    return study_tool("check", args);
+  }
+  return fsi::launcher::check_file(c.file, c.overrides, c.placed, c.json);
 }
 
 // `fsi keys DIR`: the coupler writes the key folder. Replaces this process; returns only on failure.
@@ -833,13 +844,20 @@ int main(int argc, char** argv) {
                          "every option after the study file goes to the study tool, see fsi study STUDY.yaml --help)");
   study_cmd->allow_extras();
   study_cmd->prefix_command();
+  auto* list_cmd = app.add_subcommand(
+      "list",
+      "the scenes and studies of this checkout: description, solvers, unknowns and the wall time measured "
+      "on a reference machine (configs/catalog.json); a study's estimated total: fsi list [--json]");
+  list_cmd->allow_extras();
+  list_cmd->prefix_command();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;  // command-line errors exit 1, like every failed run
   }
   if (const int code = settle_run_options(o, run_cmd->parsed()); code >= 0) return code;
-  if (study_cmd->parsed()) return study(study_cmd->remaining());
+  if (study_cmd->parsed()) return study_tool("run", study_cmd->remaining());
+  if (list_cmd->parsed()) return study_tool("list", list_cmd->remaining());
   if (check_cmd->parsed()) return check(check_options);
   if (keys_cmd->parsed()) return keys(keys_dir);
   if (plot_cmd->parsed()) return fsi::launcher::plot_folder(plot_dir, python_interpreter(), self_dir());

@@ -31,7 +31,7 @@ from .analysis import analyse, print_counts
 from .plots import cmd_plot
 from .runner import Runner
 from .spec import GridSource, Study, build_sources, reference_spec
-from .check import fsi_has_check, check_overrides
+from .check import check_overrides, check_study, fsi_has_check
 from .util import REPO, StudyError, clean_value, read_json
 
 
@@ -71,7 +71,10 @@ def first_specs(study):
     return specs
 
 
-def dry_run(study, out, sources, n, check_how):
+def dry_run(study, out, sources, n, check_how, jobs):
+    from .. import catalog
+    measured = catalog.load_catalog()
+    scene = Path(study.scene).stem
     bis = (study.stability or {}).get("bisection")
     print(f"study '{study.name}' (dry run, nothing is run): {n} {'bisection groups' if bis else 'runs'} of "
           f"{study.scene}; keys checked ({check_how})")
@@ -82,25 +85,47 @@ def dry_run(study, out, sources, n, check_how):
             if s is None:
                 break
             i += 1
+            overrides = {k: yaml.safe_load(v) for k, v in (x.split("=", 1) for x in s["sets"])}
+            e = catalog.estimate(scene, study.scene_values, overrides, measured)
             print(f"{i:4d}  {out / 'runs' / s['name']}")
             print("      " + " ".join(f"--set {x}" for x in s["sets"]))
+            print(f"      about {catalog.duration(min(e, study.time_limit))}" if e is not None else
+                  "      (no estimate: the scene has no measured wall time)")
             if bis:  # only the first value of each bisection is known before running
                 print(f"      (bisection of {study.stability['parameter']}: further values follow the outcomes)")
                 break
             src.done(s, {"outcome": "completed"})
+    runs, total, unknown, how = catalog.study_estimate(study, measured)
+    if total is None:
+        print(f"estimate: none ({scene} has no measured wall time in {catalog.CATALOG}; bench/catalog.py measure {scene})")
+    else:
+        print(f"estimate: {catalog.duration(total)} for {runs} run(s) one after the other"
+              f"{' (bisection: worst case)' if bis else ''}, about {catalog.duration(total / jobs)} with --jobs {jobs}"
+              f" (each run capped at the time limit {study.time_limit:g} s; scaled from the scene's measured "
+              f"time per step{'; ' + str(unknown) + ' run(s) not counted' if unknown else ''})")
     return 0
 
 
 def check_every_case(study, fsi, sets):
-    """`fsi check STUDY`: every value of every varied key on top of the fixed ones, at the study's
-    line; a study with any invalid case stops here, before anything runs."""
+    """Every value of every varied key on top of the fixed ones (`fsi check STUDY`): a study with
+    any invalid case stops here, before anything runs."""
     if not fsi_has_check(fsi):
         return
     scene_sets = [s for s in (sets or []) if "." in s.split("=", 1)[0]]
-    cmd = [fsi, "check", str(study.path)] + [x for s in scene_sets for x in ("--set", s)]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
-    if p.returncode != 0:
-        raise StudyError(f"the study has invalid cases; nothing was run:\n{(p.stdout + p.stderr).strip()}")
+    problems, _, _ = check_study(study.path, fsi, scene_sets)
+    if problems:
+        raise StudyError("the study has invalid cases; nothing was run:\n" + "\n".join(problems))
+
+
+def cmd_check(args):
+    """`fsi check STUDY`: "OK: ..." on stdout and 0, or the problems at the study's lines on stderr and 1."""
+    fsi = args.fsi or os.environ.get("FSI_BIN") or str(REPO / "build" / "bin" / "fsi")
+    problems, keys, scene = check_study(args.study, fsi, args.set)
+    if problems:
+        print("\n".join(problems), file=sys.stderr)
+        return 1
+    print(f"OK: {args.study} (scene {scene}, {keys} keys checked)")
+    return 0
 
 
 def make_runner(args, study, out, fsi, jobs):
@@ -133,7 +158,7 @@ def cmd_run(args):
         sources.insert(0, GridSource([ref]))
         n += 1
     if args.dry_run:
-        return dry_run(study, out, sources, n, check_how)
+        return dry_run(study, out, sources, n, check_how, jobs)
     out.mkdir(parents=True, exist_ok=True)
     copy = dict(study.raw)
     copy["scene"] = str(study.scene)  # the copy works from DIR (plot, analyse)
@@ -210,6 +235,11 @@ def cmd_analyse(args):
     return 0
 
 
+def cmd_list(args):
+    from .. import catalog
+    return catalog.main((["--json"] if args.json else []) + (["--catalog", args.catalog] if args.catalog else []))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="fsi_study.py", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -238,12 +268,19 @@ def main(argv=None):
                         "(KilledWorker: its workers died); default 2")
     p = sub.add_parser("plot", help="PNGs from DIR/results.csv")
     p.add_argument("dir")
+    c = sub.add_parser("check", help="every case of a study against the scene schema (fsi check STUDY)")
+    c.add_argument("study")
+    c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    c.add_argument("--fsi", default="")
+    ls = sub.add_parser("list", help="the scenes and studies of this checkout with their measured wall times")
+    ls.add_argument("--json", action="store_true")
+    ls.add_argument("--catalog", default="")
     a = sub.add_parser("analyse", help="recompute DIR/results.* from the runs on disk, running nothing")
     a.add_argument("dir")
     a.add_argument("--study", default="")
     args = ap.parse_args(argv)
     try:
-        return {"run": cmd_run, "plot": cmd_plot, "analyse": cmd_analyse}[args.cmd](args)
+        return {"run": cmd_run, "plot": cmd_plot, "analyse": cmd_analyse, "list": cmd_list, "check": cmd_check}[args.cmd](args)
     except StudyError as e:
         print(f"fsi_study: {e}", file=sys.stderr)
         return 1
