@@ -1,0 +1,179 @@
+#!/usr/bin/python3
+"""Measure what every shipped scene costs, for `fsi list` and `fsi study --dry-run`: writes
+configs/catalog.json.
+
+Usage:
+  /usr/bin/python3 bench/catalog.py measure [SCENE ...] [--out DIR] [--max-wall S] [--fsi PATH]
+  /usr/bin/python3 bench/catalog.py compare RUN_DIR ...     estimates against runs' measured wall times
+
+measure: each scene (default: every configs/*.yaml) run as shipped (`fsi run configs/S.yaml
+--out DIR/S --force`, one after the other: one solver job), its wall time, steps, coupling
+iterations and unknowns (from the servers' logs) written into configs/catalog.json with the
+machine, the commit and the date. A scene still running after --max-wall seconds (default 600)
+is stopped (Ctrl-C, its folder stays consistent) and its whole-run time extrapolated from the
+steps done (marked `extrapolated`). Run it on an otherwise idle machine.
+
+compare: for finished runs (summary.json with the scene and its overrides), the catalog's
+estimate against the run's own wall time, and the ratio.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "python"))
+from fsi import catalog  # noqa: E402
+
+
+def machine():
+    model = platform.processor() or "?"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{model}, {os.cpu_count()} cores"
+
+
+def commit():
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.TimeoutExpired):
+        return "?"
+
+
+def unknowns(run):
+    """(fluid unknowns, solid unknowns) from the servers' logs, None where there is no such server."""
+    def find(log, pattern):
+        try:
+            m = re.search(pattern, (run / log).read_text(errors="replace"))
+            return int(m.group(1)) if m else None
+        except OSError:
+            return None
+    fluid = find("fluid_server.log", r"(\d+) unknowns")
+    solid = find("solid_server.log", r"(\d+) free dofs")
+    if solid is None and (run / "solid_server.log").exists():
+        solid = find("solid_server.log", r"(\d+) dofs?\b") or 1
+    return fluid, solid
+
+
+def measure_one(fsi, scene, out, max_wall):
+    run = out / scene.stem
+    cmd = [fsi, "run", str(scene), "--out", str(run), "--force"]
+    print(f"{scene.stem}: {' '.join(cmd)}", flush=True)
+    t0 = time.monotonic()
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+                         start_new_session=True)
+    stopped = False
+    try:
+        p.wait(timeout=max_wall)
+    except subprocess.TimeoutExpired:
+        stopped = True
+        os.killpg(p.pid, signal.SIGINT)  # a clean stop: the run writes its summary
+        try:
+            p.wait(timeout=120)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+    wall = time.monotonic() - t0
+    try:
+        summary = json.loads((run / "summary.json").read_text())
+    except (OSError, ValueError):
+        print(f"  no summary.json: not recorded", flush=True)
+        return None
+    info = catalog.scene_info(scene)
+    steps_done = int(summary.get("steps") or 0)
+    if steps_done == 0:
+        print(f"  {summary.get('status')}, no step: not recorded", flush=True)
+        return None
+    total_steps = info["steps"] or steps_done
+    fluid, solid = unknowns(run)
+    iterations = summary.get("coupling_iterations")
+    entry = {"wall_s": round(wall if not stopped else wall * total_steps / steps_done, 2),
+             "measured_steps": steps_done if not stopped else total_steps,
+             "steps": total_steps, "status": summary.get("status"),
+             "iterations_per_step": round(iterations / steps_done, 2) if iterations else None,
+             "fluid_unknowns": fluid, "solid_unknowns": solid}
+    if stopped:
+        entry["extrapolated"] = f"from {steps_done} of {total_steps} steps in {wall:.0f} s"
+    print(f"  {entry}", flush=True)
+    return entry
+
+
+def cmd_measure(a):
+    scenes = [ROOT / "configs" / (s if s.endswith(".yaml") else s + ".yaml") for s in a.scenes] or \
+        catalog.scene_files()
+    out = Path(a.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    data = catalog.load_catalog()
+    data.setdefault("scenes", {})
+    for scene in scenes:
+        entry = measure_one(a.fsi, scene, out, a.max_wall)
+        if entry is None:
+            continue
+        data["scenes"][scene.stem] = entry
+        data["measured"] = {"machine": machine(), "date": datetime.date.today().isoformat(), "commit": commit(),
+                            "how": "bench/catalog.py measure: each scene as shipped, one solver job, idle machine"}
+        catalog.CATALOG.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")  # after every scene
+    return 0
+
+
+def cmd_compare(a):
+    data = catalog.load_catalog()
+    import yaml
+    print(f"{'run':<50} {'scene':<14} {'measured':>10} {'estimate':>10} {'ratio':>6}")
+    for r in a.runs:
+        s = json.loads((Path(r) / "summary.json").read_text())
+        scene = Path(s["scene_file"])
+        if not scene.is_absolute():
+            scene = ROOT / scene
+        values = catalog_flatten(yaml.safe_load(scene.read_text()))
+        overrides = {k: yaml.safe_load(v) for k, v in (o.split("=", 1) for o in s.get("overrides", []))}
+        wall = s["wall_time"]["total"] + float(s.get("wall_time_earlier_segments") or 0)
+        e = catalog.estimate(scene.stem, values, overrides, data)
+        if e is not None and s.get("steps"):
+            dt = float(overrides.get("time.dt", values.get("time.dt")))
+            end = float(overrides.get("time.end", values.get("time.end")))
+            e *= s["steps"] / max(1, round(end / dt))  # the steps this run made
+        ratio = f"{e / wall:.2f}" if e else "-"
+        print(f"{r[-50:]:<50} {scene.stem:<14} {wall:>9.1f}s {e or 0:>9.1f}s {ratio:>6}")
+    return 0
+
+
+def catalog_flatten(d, prefix=""):
+    out = {}
+    for k, v in (d or {}).items():
+        if isinstance(v, dict):
+            out.update(catalog_flatten(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    m = sub.add_parser("measure")
+    m.add_argument("scenes", nargs="*")
+    m.add_argument("--out", default=str(ROOT / "runs" / "catalog"))
+    m.add_argument("--max-wall", type=float, default=600.0)
+    m.add_argument("--fsi", default=os.environ.get("FSI_BIN", str(ROOT / "build" / "bin")) + "/fsi")
+    c = sub.add_parser("compare")
+    c.add_argument("runs", nargs="+")
+    a = ap.parse_args()
+    return {"measure": cmd_measure, "compare": cmd_compare}[a.cmd](a)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

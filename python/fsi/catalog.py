@@ -1,0 +1,234 @@
+"""What a checkout ships and what it costs: `fsi list` (the scenes and the studies with their
+description, solvers, unknowns and measured wall time) and the estimates of `fsi study --dry-run`.
+
+The wall times come from configs/catalog.json, written by `bench/catalog.py measure`: every
+scene run as shipped, one solver job on an otherwise idle machine (that machine, the commit and
+the date are in the file). An estimate for other settings scales the measured time per step:
+
+    wall = (measured wall / measured steps) * steps * (h_scene / h)^2
+
+steps = time.end / time.dt of the run, h = fluid.mesh.size when a run overrides it (the fluid's
+unknowns grow as 1/h^2; the fluid is most of the cost of every fluid scene). Nothing else is
+scaled (coupling iterations, solid mesh, schemes): an estimate, good to a factor of about 2, and
+a study's run never counts longer than its time limit (it is stopped there).
+"""
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+import yaml
+
+from .study.util import REPO
+
+CATALOG = Path(os.environ.get("FSI_CATALOG") or REPO / "configs" / "catalog.json")  # FSI_CATALOG: tests
+
+
+def load_catalog(path=None):
+    """configs/catalog.json as a dict ({} when missing): {"measured": {...}, "scenes": {name: {...}}}."""
+    p = Path(path) if path else CATALOG
+    try:
+        return json.loads(p.read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def _get(d, dotted, default=None):
+    for part in dotted.split("."):
+        if not isinstance(d, dict) or part not in d:
+            return default
+        d = d[part]
+    return d
+
+
+def scene_info(path):
+    """A scene file's name, description and solvers, from its YAML (nothing is meshed)."""
+    path = Path(path)
+    d = yaml.safe_load(path.read_text()) or {}
+    fluid, solid = d.get("fluid") or {}, d.get("solid") or {}
+    dt, end = _get(d, "time.dt"), _get(d, "time.end")
+    steps = int(round(float(end) / float(dt))) if dt and end else None
+
+    def solver(section, default_element):
+        if not section:
+            return "-"
+        model = section.get("model", "?")
+        if model != "fem":
+            return model
+        element = section.get("element", default_element)
+        return f"{element}"
+
+    return {"name": path.stem, "file": str(path), "description": str(d.get("description", "")),
+            "fluid": solver(fluid, "p1p1"), "solid": solver(solid, "q4"), "steps": steps,
+            "dt": dt, "end": end, "mesh_size": _get(d, "fluid.mesh.size")}
+
+
+def scene_files():
+    return sorted((REPO / "configs").glob("*.yaml"))
+
+
+def study_files():
+    return sorted((REPO / "studies").glob("*.yaml"))
+
+
+def _number(v):
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return None
+
+
+def estimate(scene_name, scene_values, overrides, catalog):
+    """Estimated wall seconds of one run of `scene_name` with `overrides` ({dotted key: value}),
+    or None when the scene was not measured. scene_values: the scene's own flattened values."""
+    entry = (catalog.get("scenes") or {}).get(scene_name)
+    if not entry or not entry.get("measured_steps"):
+        return None
+    per_step = float(entry["wall_s"]) / float(entry["measured_steps"])
+    dt = _number(overrides.get("time.dt", scene_values.get("time.dt")))
+    end = _number(overrides.get("time.end", scene_values.get("time.end")))
+    steps = max(1, int(round(end / dt))) if dt and end else int(entry.get("steps") or entry["measured_steps"])
+    scale = 1.0
+    h0, h = _number(scene_values.get("fluid.mesh.size")), _number(overrides.get("fluid.mesh.size"))
+    if h0 and h and h > 0:
+        scale = (h0 / h) ** 2
+    return per_step * steps * scale
+
+
+def study_estimate(study, catalog):
+    """(number of runs, estimated wall seconds of all of them run one at a time, how) of a
+    fsi.study.Study. A bisection counts its worst case, 2 + log2((hi - lo) / tol) runs per group."""
+    from .study.spec import build_sources, reference_spec
+    scene_values = study.scene_values
+    name = Path(study.scene).stem
+    limit = float(study.time_limit)
+    st = study.stability or {}
+    bis = st.get("bisection")
+    runs, total, unknown = 0, 0.0, 0
+    specs = []
+    if bis:
+        lo, hi, tol = float(bis.get("lo", 0.0)), float(bis.get("hi", 1.0)), float(bis.get("tol", 0.005))
+        per_group = 2 + max(0, math.ceil(math.log2(max((hi - lo) / tol, 1.0))))
+        for combo in study.combos():
+            spec = study.spec(dict(combo, **{st["parameter"]: hi}))
+            specs += [spec] * per_group
+    else:
+        sources, _ = build_sources(study)
+        for src in sources:
+            while (s := src.next()) is not None:
+                specs.append(s)
+                src.done(s, {"outcome": "completed"})
+    ref = reference_spec(study)
+    if ref and not ref.get("shared"):
+        specs.append(ref)
+    for s in specs:
+        overrides = dict(kv.split("=", 1) for kv in s["sets"])
+        overrides = {k: _yaml_value(v) for k, v in overrides.items()}
+        e = estimate(name, scene_values, overrides, catalog)
+        runs += 1
+        if e is None:
+            unknown += 1
+            continue
+        total += min(e, limit)
+    how = "bisection worst case" if bis else "grid"
+    return runs, (None if unknown == runs else total), unknown, how
+
+
+def _yaml_value(v):
+    try:
+        return yaml.safe_load(v)
+    except yaml.YAMLError:
+        return v
+
+
+def duration(seconds):
+    """12 s, 3.4 min, 1.2 h."""
+    if seconds is None:
+        return "not measured"
+    if seconds < 1:
+        return "< 1 s"
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def _unknowns(entry):
+    if not entry:
+        return ""
+    parts = []
+    if entry.get("fluid_unknowns"):
+        parts.append(f"{entry['fluid_unknowns']:,} fluid")
+    if entry.get("solid_unknowns"):
+        parts.append(f"{entry['solid_unknowns']:,} solid")
+    return " + ".join(parts)
+
+
+def rows(catalog):
+    """The scenes and the studies as dicts (`fsi list --json`)."""
+    from .study.spec import Study
+    from .study.util import StudyError
+    scenes = []
+    for f in scene_files():
+        info = scene_info(f)
+        entry = (catalog.get("scenes") or {}).get(info["name"])
+        info["wall_s"] = entry.get("wall_s") if entry else None
+        info["measured"] = entry
+        scenes.append(info)
+    studies = []
+    for f in study_files():
+        row = {"name": f.stem, "file": str(f)}
+        try:
+            s = Study(f)
+            runs, total, unknown, how = study_estimate(s, catalog)
+            row.update(description=s.description, scene=Path(s.scene).stem, runs=runs, estimate_s=total,
+                       not_measured=unknown, count=how, time_limit=s.time_limit)
+        except StudyError as e:
+            row.update(description="", error=str(e))
+        studies.append(row)
+    return {"measured": catalog.get("measured"), "scenes": scenes, "studies": studies}
+
+
+def _short(text, n):
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+def print_list(data, out=sys.stdout):
+    m = data.get("measured") or {}
+    where = f"measured on {m.get('machine', '?')}, {m.get('date', '?')}" if m else "configs/catalog.json missing"
+    print(f"Scenes (configs/; fsi run configs/NAME.yaml; wall time of the whole run {where}):", file=out)
+    print(f"  {'NAME':<14} {'FLUID':<9} {'SOLID':<7} {'UNKNOWNS':<26} {'STEPS':>6} {'WALL':>12}  DESCRIPTION",
+          file=out)
+    for s in data["scenes"]:
+        print(f"  {s['name']:<14} {s['fluid']:<9} {s['solid']:<7} {_unknowns(s['measured']):<26} "
+              f"{s['steps'] or '':>6} {duration(s['wall_s']):>12}  {_short(s['description'], 70)}", file=out)
+    print("\nStudies (studies/; fsi study studies/NAME.yaml --out DIR; estimate: the runs one after the other, "
+          "each capped at the study's time limit; divide by --jobs):", file=out)
+    print(f"  {'NAME':<18} {'SCENE':<12} {'RUNS':>5} {'ESTIMATE':>12}  DESCRIPTION", file=out)
+    for s in data["studies"]:
+        if "error" in s:
+            print(f"  {s['name']:<18} invalid: {s['error']}", file=out)
+            continue
+        runs = f"<={s['runs']}" if s["count"] != "grid" else str(s["runs"])
+        est = duration(s["estimate_s"]) + ("*" if s["not_measured"] and s["estimate_s"] is not None else "")
+        print(f"  {s['name']:<18} {s['scene']:<12} {runs:>5} {est:>12}  {_short(s['description'], 70)}", file=out)
+    if any(s.get("not_measured") and s.get("estimate_s") is not None for s in data["studies"]):
+        print("  * some runs of the study have no measured scene and are not counted", file=out)
+
+
+def main(argv=None):
+    import argparse
+    ap = argparse.ArgumentParser(prog="fsi list", description="the scenes and studies of this checkout, with "
+                                 "their solvers, unknowns and measured wall times")
+    ap.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    ap.add_argument("--catalog", default="", help="the measured durations (default: configs/catalog.json)")
+    args = ap.parse_args(argv)
+    data = rows(load_catalog(args.catalog or None))
+    if args.json:
+        json.dump(data, sys.stdout, indent=1, default=str)
+        print()
+    else:
+        print_list(data)
+    return 0
