@@ -108,6 +108,34 @@ def case_install(a, tmp):
     tool = str(prefix / "share/fsi/tools/fsi_study.py")
     check(p.returncode == 0 and tool in p.stderr, f"installed fsi study uses {tool}: exit {p.returncode} "
           f"{(p.stderr.strip().splitlines() or [''])[0][:300]}")
+    p = run([fsi, "list"], timeout=60, cwd=tmp)
+    check(p.returncode == 0 and "fsi3_p2p1" in p.stdout and "not measured" not in p.stdout,
+          f"installed fsi list: every scene with its measured wall time (exit {p.returncode})")
+
+
+def case_list(a, tmp):
+    """`fsi list --json`: every shipped scene and study, each scene with a measured wall time and
+    its unknowns, each study with its number of runs and an estimate."""
+    p = run([a.build / "bin/fsi", "list", "--json"], timeout=60)
+    check(p.returncode == 0, f"fsi list --json: exit {p.returncode} {p.stderr.strip()[-300:]}")
+    data = json.loads(p.stdout)
+    scenes = {s["name"]: s for s in data["scenes"]}
+    studies = {s["name"]: s for s in data["studies"]}
+    shipped = {f.stem for f in (a.source / "configs").glob("*.yaml")}
+    check(set(scenes) == shipped, f"every scene of configs/ listed ({len(scenes)} of {len(shipped)})")
+    check(set(studies) == {f.stem for f in (a.source / "studies").glob("*.yaml")}, "every study of studies/ listed")
+    unmeasured = [n for n, s in scenes.items() if not s["wall_s"] or s["wall_s"] <= 0]
+    check(not unmeasured, f"every scene has a measured wall time (missing: {unmeasured})")
+    no_unknowns = [n for n, s in scenes.items() if s["fluid"] in ("p1p1", "p2p1")
+                   and not (s["measured"] or {}).get("fluid_unknowns")]
+    check(not no_unknowns, f"every FEM fluid scene has its unknowns (missing: {no_unknowns})")
+    check(all(s["description"] for s in scenes.values()), "every scene has a description")
+    bad = {n: s.get("error") or "no estimate" for n, s in studies.items()
+           if s.get("error") or not s.get("runs") or s.get("estimate_s") is None}
+    check(not bad, f"every study is read, counted and estimated ({bad})")
+    check(data["measured"] and data["measured"].get("machine"), f"the catalog names its machine: {data['measured']}")
+    p = run([a.build / "bin/fsi", "list"], timeout=60)
+    check(p.returncode == 0 and all(n in p.stdout for n in shipped), "fsi list prints every scene")
 
 
 def case_fluid_standalone(a, tmp):
@@ -138,12 +166,21 @@ def case_fluid_standalone(a, tmp):
           f"summary solver_iterations {s.get('solver_iterations')} = the step's Picard solves {solves}")
     log = out / "fluid_server.log"
     text = log.read_text() if log.exists() else ""
-    progress = [ln for ln in text.splitlines() if "step 1/1 " in ln]
+    progress = [ln for ln in text.splitlines() if "step 1/1 t=" in ln]
     check(len(progress) == 1 and re.search(r"\[fluid_server\] \[info\] step 1/1 t=1 iterations \d+ elapsed [\d.]+ s, "
                                            r"ETA 0\.0 s$", progress[0]) is not None,
           f"fluid_server.log: one progress line {progress}")
     check("completed 1 steps" in text and "fluid: " in text, "fluid_server.log holds the solver's and the runner's lines")
     check(not re.search(r"\] step \d+ t=[\d.]+/", text + p.stderr), "no second progress format (step t=T/END ...)")
+    # Inside the step: a line per nonlinear iteration once the step has run for the interval
+    # (2 s; 0 here), so a long steady solve is not silent.
+    out3 = tmp / "dfg_progress"
+    q = run([bindir / "fsi", "run", scene, "--out", out3, *coarse], timeout=240,
+            env=dict(os.environ, FSI_PROGRESS_INTERVAL="0"))
+    inside = re.findall(r"step 1/1 nonlinear iteration (\d+) change [\d.e+-]+ \(this step: [\d.]+ s so far\)",
+                        (out3 / "fluid_server.log").read_text() if (out3 / "fluid_server.log").exists() else "")
+    check(q.returncode == 0 and [int(i) for i in inside] == list(range(1, solves + 1)),
+          f"progress inside the step: one line per nonlinear iteration 1..{solves} ({inside})")
     # The deprecated alias: a deprecation line, the same run.
     alias = bindir / "fluid_run"
     if alias.exists():
@@ -157,7 +194,7 @@ def case_fluid_standalone(a, tmp):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--case", required=True, choices=["version", "install", "fluid_standalone"])
+    ap.add_argument("--case", required=True, choices=["version", "install", "fluid_standalone", "list"])
     ap.add_argument("--build", type=Path, required=True)
     ap.add_argument("--source", type=Path, required=True)
     ap.add_argument("--version", required=True)

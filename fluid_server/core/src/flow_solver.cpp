@@ -446,6 +446,7 @@ StepReport FlowSolver::solve(double time, double dt, const Eigen::MatrixX2d& pos
     U_ = U_new;
     U_lin = U_new;
     reaction_ = im.volume * U_ - im.rhs_volume;
+    if (observer_) observer_(iteration, change);
     if (report.change < params_.tolerance) break;
   }
   return report;

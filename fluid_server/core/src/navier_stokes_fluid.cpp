@@ -305,6 +305,7 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
   read_remesh(section, !interface_groups.empty());
   if (remesh_.enabled || !remesh_.at_steps.empty()) original_mesh_ = mesh;  // a checkpoint before the first remesh
   solver_ = std::make_unique<FlowSolver>(std::move(mesh), params, element_);
+  watch(*solver_);
   const auto& fluid_mesh = solver_->mesh();
 
   const auto fixed_groups = add_boundary_conditions(section, msh.string());
@@ -522,9 +523,17 @@ void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
       transfer.max_distance, seconds, r.seconds);
 }
 
+// The solver's nonlinear iterations reach whoever runs this model (IterationReporting).
+void NavierStokesFluid::watch(FlowSolver& solver) const {
+  solver.set_iteration_observer([this](int iteration, double change) {
+    report_iteration(fmt::format("nonlinear iteration {} change {:.2e}", iteration, change));
+  });
+}
+
 // A solver on `mesh` with the scene's conditions and interface.
 std::unique_ptr<FlowSolver> NavierStokesFluid::make_solver(FluidMesh mesh, const FlowParameters& params) const {
   auto s = std::make_unique<FlowSolver>(std::move(mesh), params, element_);
+  watch(*s);
   for (const auto& c : conditions_) c(*s);
   if (!interface_groups_.empty()) s->set_interface(interface_groups_);
   return s;

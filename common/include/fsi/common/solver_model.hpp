@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -86,7 +87,22 @@ struct SolidStepResult {
   int newton_iterations = 0;
 };
 
-class SolidModel {
+// Inside a long solve, after each nonlinear iteration, a short text for whoever runs the model
+// (a standalone run prints it every 2 s, so a long step is not silent). Unset: nothing happens.
+class IterationReporting {
+ public:
+  void on_iteration(std::function<void(const std::string&)> observer) { on_iteration_ = std::move(observer); }
+
+ protected:
+  void report_iteration(const std::string& text) const {
+    if (on_iteration_) on_iteration_(text);
+  }
+
+ private:
+  std::function<void(const std::string&)> on_iteration_;
+};
+
+class SolidModel : public IterationReporting {
  public:
   virtual ~SolidModel() = default;
   virtual std::string name() const = 0;
@@ -145,7 +161,7 @@ struct FluidLoads {
   NodalMatrix interface_mass;  // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
 };
 
-class FluidModel {
+class FluidModel : public IterationReporting {
  public:
   virtual ~FluidModel() = default;
   virtual std::string name() const = 0;

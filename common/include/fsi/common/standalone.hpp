@@ -67,6 +67,7 @@ class Progress {
   std::string logger_name_;
   int total_;
   int first_;
+  double interval_;  // seconds between lines: 2 ($FSI_PROGRESS_INTERVAL)
   double start_;
   double last_ = -1e9;
   double step_start_ = 0;   // wall time at the end of the previous step (or at the start)

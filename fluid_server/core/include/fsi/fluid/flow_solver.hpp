@@ -120,6 +120,8 @@ class FlowSolver {
   void set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value);  // nearest vertex
   void set_body_force(VelocityFunction force);
   void set_initial_velocity(const Eigen::MatrixX2d& velocity);  // per node
+  // Called after each nonlinear iteration of solve() with the iteration and the relative change.
+  void set_iteration_observer(std::function<void(int, double)> observer) { observer_ = std::move(observer); }
 
   // --- stepping ---
   // Solves time level `time` (= t_n + dt) from the accepted state, on the mesh at `positions`
@@ -198,6 +200,7 @@ class FlowSolver {
   std::vector<int> interface_nodes_;
   IndexMatrix2 interface_segments_;
   Eigen::VectorXd interface_velocity_;  // of the last solve
+  std::function<void(int, double)> observer_;
   Step begin_step(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity);
   void assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report);
   bool locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const;

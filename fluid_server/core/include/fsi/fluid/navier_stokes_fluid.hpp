@@ -112,6 +112,7 @@ class NavierStokesFluid : public FluidModel {
   void read_remesh(const schema::Reader& section, bool moving);
   void remesh(const StepInfo& info, const std::string& why);
   std::unique_ptr<FlowSolver> make_solver(FluidMesh mesh, const FlowParameters& params) const;
+  void watch(FlowSolver& solver) const;
   void save_remeshed(StateArchive& state) const;
   void load_remeshed(const StateArchive& state);
   static FluidMesh mesh_from_state(const StateArchive& state);
