@@ -46,10 +46,10 @@ with tempfile.TemporaryDirectory() as tmp:
         d.mkdir()
         (d / "summary.json").write_text(json.dumps({"status": "completed"}))
         (d / "fluid_server.log").write_text(f"[fluid] fluid: p2p1 (Taylor-Hood), 1 nodes, 1 triangles, {lv * 20000} unknowns\n")
-        dt, end = 0.0005, 2.0
+        dt, start, end = 0.0005, 3.0, 5.0  # the periodic state (levels.py refuses windows before t = 3.5)
         rows, trows = [], []
-        for i in range(1, int(round(end / dt)) + 1):
-            t = i * dt
+        for i in range(1, int(round((end - start) / dt)) + 1):
+            t = start + i * dt
             s1, c2 = math.sin(2 * math.pi * f_y * t), math.cos(4 * math.pi * f_y * t)
             ux = ref["ux"][0] + ref["ux"][1] * (1 + e) * c2
             uy = ref["uy"][0] + ref["uy"][1] * (1 + e) * s1
@@ -89,5 +89,14 @@ with tempfile.TemporaryDirectory() as tmp:
                        capture_output=True, text=True, timeout=120)
     r = json.loads(out.read_text())["levels"]
     check("at least 3" in r["3"].get("refused", ""), f"a 0.2 s level is refused: {r['3'].get('refused')}")
+    # a level whose last periods are still in the start-up transient is refused too
+    early = [ln for ln in src[1:] if float(ln.split(",")[0]) <= 4.0]
+    (d / "probes.csv").write_text("\n".join([src[0]] + [f"{float(ln.split(',')[0]) - 1.0:.6f}," + ln.split(",", 1)[1]
+                                                       for ln in early]) + "\n")
+    p = subprocess.run([sys.executable, str(SCRIPT), "table", "fsi3", "--out", tmp, "--json", str(out)],
+                       capture_output=True, text=True, timeout=120)
+    r = json.loads(out.read_text())["levels"]
+    check("before the periodic state" in r["3"].get("refused", ""),
+          f"a level ending at t = 3 (window before t = 3.5) is refused: {r['3'].get('refused')}")
 
 sys.exit(1 if failures else 0)
