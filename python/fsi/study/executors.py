@@ -91,7 +91,8 @@ def run_case_task(payload):
         state = "finished"
         t0 = time.monotonic()
         with open(d / "fsi.log", "w") as log:
-            proc = start_run_process(fsi, scene, d, payload["sets"], log, parent_death_signal=signal.SIGTERM)
+            proc = start_run_process(fsi, scene, d, payload["sets"], log, parent_death_signal=signal.SIGTERM,
+                                     fork=payload.get("from"))
             try:
                 while reap(proc) is None:
                     if time.monotonic() - t0 > payload["time_limit"]:
@@ -208,7 +209,8 @@ class DaskRunner(Runner):
     def _submit(self, spec):
         payload = {"name": spec["name"], "study_id": self.study_id, "scene": str(self.study.scene),
                    "scene_text": self.scene_text, "sets": spec["sets"], "fsi": self.fsi,
-                   "time_limit": self.study.time_limit, "shared_dir": self.shared_dir}
+                   "time_limit": self.study.time_limit, "shared_dir": self.shared_dir,
+                   "from": str(self.study.fork) if self.study.fork else None}
         key = f"fsi-run-{spec['name']}-{uuid.uuid4().hex[:8]}"
         fut = self.client.submit(run_case_task, payload, key=key, pure=False)
         self.futures[spec["name"]] = (fut, spec, time.time())

@@ -52,11 +52,14 @@ def reap(proc, block=False, timeout=None):
         time.sleep(0.01)
 
 
-def start_run_process(fsi, scene, d, sets, log, parent_death_signal=None):
-    """`fsi run SCENE --out D --force --set ...` in its own session, output to the open file log.
+def start_run_process(fsi, scene, d, sets, log, parent_death_signal=None, fork=None):
+    """`fsi run SCENE --out D --force [--from CHECKPOINT] --set ...` in its own session, output to
+    the open file log.
     parent_death_signal: the signal the launcher gets when the thread that started it dies (a
     Dask worker killed with SIGKILL: the launcher then stops its servers and coupler)."""
     cmd = [fsi, "run", str(scene), "--out", str(d), "--force"]
+    if fork:
+        cmd += ["--from", str(fork)]
     for s in sets:
         cmd += ["--set", s]
     pre = None
@@ -223,7 +226,7 @@ class Runner:
     def start(self, spec):
         d = self.prepare(spec)
         log = open(d / "fsi.log", "w")
-        proc = start_run_process(self.fsi, self.study.scene, d, spec["sets"], log)
+        proc = start_run_process(self.fsi, self.study.scene, d, spec["sets"], log, fork=self.study.fork)
         self.running[spec["name"]] = (proc, spec, time.monotonic(), log)
         self.started += 1
 

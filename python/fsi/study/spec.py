@@ -85,6 +85,7 @@ class Study:
         if "scene" not in d:
             raise StudyError(f"{path}: 'scene' is required")
         self.scene = self._find(d["scene"])
+        self.fork = self._find_checkpoint(d["from"]) if d.get("from") else None
         self.fixed = {k: clean_value(v) for k, v in flatten(d.get("fixed")).items()}
         self.vary = {k: expand(k, v) for k, v in (d.get("vary") or {}).items()}
         self.zip = []
@@ -124,6 +125,15 @@ class Study:
                 return c.resolve()
         raise StudyError(f"{self.path}: scene '{scene}' not found (relative to the study, the cwd or {REPO})")
 
+    def _find_checkpoint(self, given):
+        """`from`: a run folder (its newest checkpoint) or one checkpoint folder, relative to the
+        study file or the working folder; every run of the study forks from it (fsi run --from)."""
+        p = Path(str(given))
+        for c in ([p] if p.is_absolute() else [self.path.parent / p, Path.cwd() / p]):
+            if c.is_dir():
+                return c.resolve()
+        raise StudyError(f"{self.path}: from '{given}': no such run or checkpoint folder")
+
     def base_params(self):
         b = dict(self.scene_values)
         b.update(self.fixed)
@@ -157,7 +167,10 @@ class Study:
         overrides = dict(self.fixed)
         overrides.update({k: v for k, v in combo.items() if "." in k})  # no dot: a study variable
         sets = [f"{k}={set_value(v)}" for k, v in sorted(overrides.items())]
-        key = json.dumps({"scene": self.scene.name, "sets": sets}, sort_keys=True)
+        key = {"scene": self.scene.name, "sets": sets}
+        if self.fork:  # another starting state: other runs (names without `from` unchanged)
+            key["from"] = str(self.fork)
+        key = json.dumps(key, sort_keys=True)
         h = hashlib.sha1(key.encode()).hexdigest()[:8]
         if name is None:
             parts = []

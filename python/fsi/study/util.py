@@ -19,8 +19,8 @@ def _repo():
 
 REPO = _repo()
 
-STUDY_KEYS = {"extends", "study", "description", "scene", "fixed", "vary", "zip", "derived", "where", "time_limit",
-              "probes", "reference", "metrics", "stability", "plots"}
+STUDY_KEYS = {"extends", "study", "description", "scene", "from", "fixed", "vary", "zip", "derived", "where",
+              "time_limit", "probes", "reference", "metrics", "stability", "plots"}
 FINISHED = ("completed", "diverged", "failed")
 ABBREV = {"coupling.algorithm": "alg", "coupling.gamma_n1": "g", "coupling.relaxation": "beta",
           "coupling.iterations.max": "kmax", "coupling.iterations.tolerance": "tol", "time.dt": "dt",
