@@ -27,8 +27,10 @@ bool is_study_file(const std::string& file) {
   }
 }
 
-int check_file(const std::string& file, const std::vector<std::string>& overrides,
-               const std::vector<std::pair<std::string, std::string>>& placed, bool json) {
+namespace {
+// One scene check with overrides (`placed`: with the place they were written), as JSON.
+nlohmann::json check_json(const std::string& file, const std::vector<std::string>& overrides,
+                          const std::vector<std::pair<std::string, std::string>>& placed) {
   std::vector<std::string> all = overrides;
   schema::CheckOptions options;
   for (const auto& [assignment, where] : placed) {
@@ -41,18 +43,44 @@ int check_file(const std::string& file, const std::vector<std::string>& override
   } catch (const ConfigError& e) {
     result.problems.push_back({"", e.what(), ""});
   }
+  nlohmann::json out = {{"file", file}, {"keys_checked", result.keys_checked}, {"problems", nlohmann::json::array()}};
+  for (const auto& p : result.problems)
+    out["problems"].push_back({{"where", p.where}, {"message", p.message}, {"key", p.key}, {"text", p.text()}});
+  return out;
+}
+}  // namespace
+
+int check_file(const std::string& file, const std::vector<std::string>& overrides,
+               const std::vector<std::pair<std::string, std::string>>& placed, bool json) {
+  const nlohmann::json result = check_json(file, overrides, placed);
   if (json) {
-    nlohmann::json out = {{"file", file}, {"keys_checked", result.keys_checked}, {"problems", nlohmann::json::array()}};
-    for (const auto& p : result.problems)
-      out["problems"].push_back({{"where", p.where}, {"message", p.message}, {"key", p.key}, {"text", p.text()}});
-    std::cout << out.dump() << "\n";
-    return result.problems.empty() ? 0 : 1;
+    std::cout << result.dump() << "\n";
+    return result["problems"].empty() ? 0 : 1;
   }
-  if (!result.problems.empty()) {
-    print(result.problems);
+  if (!result["problems"].empty()) {
+    for (const auto& p : result["problems"]) std::cerr << p["text"].get<std::string>() << "\n";
     return 1;
   }
-  std::cout << fmt::format("OK: {} ({} keys checked)\n", file, result.keys_checked);
+  std::cout << fmt::format("OK: {} ({} keys checked)\n", file, result["keys_checked"].get<int>());
+  return 0;
+}
+
+int check_cases(const std::string& file, const std::vector<std::string>& overrides,
+                const std::vector<std::pair<std::string, std::string>>& placed, std::istream& cases) {
+  nlohmann::json list;
+  try {
+    list = nlohmann::json::parse(cases);
+  } catch (const nlohmann::json::exception& e) {
+    std::cerr << "fsi check --cases: not a JSON list of cases: " << e.what() << "\n";
+    return 1;
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& c : list) {
+    auto with = placed;
+    for (const auto& pair : c) with.push_back({pair.at(0).get<std::string>(), pair.at(1).get<std::string>()});
+    out.push_back(check_json(file, overrides, with));
+  }
+  std::cout << out.dump() << "\n";
   return 0;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // `fsi check`: a scene against the scene schema, in-process, without meshing or starting a solver
 // (fsi/common/scene_schema.hpp).
+#include <istream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,12 @@ namespace fsi::launcher {
 // read by the study tool (fsi_study.py check), not here.
 int check_file(const std::string& file, const std::vector<std::string>& overrides,
                const std::vector<std::pair<std::string, std::string>>& placed = {}, bool json = false);
+
+// Many checks of one scene in one process (the study tool's cases): `cases` is a JSON list of
+// cases, each a list of [assignment, where] on top of `overrides` and `placed`; prints one JSON
+// list of the results (as --json prints one). Returns 1 only when `cases` is not such a list.
+int check_cases(const std::string& file, const std::vector<std::string>& overrides,
+                const std::vector<std::pair<std::string, std::string>>& placed, std::istream& cases);
 
 // A study file (top-level `study` or `vary`) rather than a scene.
 bool is_study_file(const std::string& file);

@@ -744,6 +744,7 @@ struct CheckOptions {
   std::vector<std::pair<std::string, std::string>> placed;
   bool reference = false;
   bool json = false;
+  bool cases = false;
 };
 
 CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
@@ -757,6 +758,9 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
                         "as --set, with the place the value was written, named in the problems: --set-at "
                         "key=value file:line:col (the study tool checks a study's cases this way)");
   check_cmd->add_flag("--json", c.json, "a scene's problems as one JSON object on stdout");
+  check_cmd->add_flag("--cases", c.cases,
+                      "read a JSON list of cases from stdin, each a list of [key=value, file:line:col] on top of "
+                      "the other overrides, and print a JSON list of their results (the study tool)");
   check_cmd->add_flag("--reference", c.reference,
                       "print the scene reference (Markdown, docs/scene-reference.md) from the schema");
   return check_cmd;
@@ -776,6 +780,7 @@ int check(const CheckOptions& c) {
     for (const auto& o : c.overrides) args.insert(args.end(), {"--set", o});
     return study_tool("check", args);
   }
+  if (c.cases) return fsi::launcher::check_cases(c.file, c.overrides, c.placed, std::cin);
   return fsi::launcher::check_file(c.file, c.overrides, c.placed, c.json);
 }
 

@@ -173,13 +173,15 @@ def study_places(path, shown):
     return fixed, varied, derived
 
 
-def _fsi_check(fsi, scene, sets, placed):
-    cmd = [fsi, "check", str(scene), "--json"]
+def _fsi_check(fsi, scene, sets, placed, cases):
+    """One `fsi check SCENE --cases` process: the results of every case (a list of
+    (assignment, where)) on top of sets and placed."""
+    cmd = [fsi, "check", str(scene), "--cases"]
     for s in sets:
         cmd += ["--set", s]
     for assignment, where in placed:
         cmd += ["--set-at", assignment, where]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=120, input=json.dumps(cases))
     try:
         return json.loads(p.stdout)
     except ValueError:
@@ -198,15 +200,14 @@ def check_study(path, fsi, cli_sets=()):
     scene_shown = rel if not rel.startswith("..") else str(scene)
     fixed, varied, derived = study_places(path, shown)
     placed = [(f"{f['key']}={f['value']}", f["where"]) for f in fixed if "." in f["key"]]
-    base = _fsi_check(fsi, scene, list(cli_sets), placed)
+    keys = [k for k in varied + derived if "." in k["key"]]  # no dot: a study variable, not a scene key
+    results = _fsi_check(fsi, scene, list(cli_sets), placed,
+                         [[]] + [[[f"{k['key']}={k['value']}", k["where"]]] for k in keys])
+    base = results[0]
     problems = [p["text"] for p in base["problems"]]
     seen = set(problems)
-    for k in varied + derived:
-        if "." not in k["key"]:
-            continue  # a study variable (no dot), not a scene key
+    for k, result in zip(keys, results[1:]):
         is_derived = k in derived
-        assignment = f"{k['key']}={k['value']}"
-        result = _fsi_check(fsi, scene, list(cli_sets), placed + [(assignment, k["where"])])
         for p in result["problems"]:
             if p["where"] != k["where"]:
                 continue

@@ -139,7 +139,8 @@ def make_runner(args, study, out, fsi, jobs):
 
 
 def cmd_run(args):
-    study = Study(args.study)
+    study = Study(args.study, fork=args.fork or None)
+    study.require_fork()
     if not args.out:
         args.out = os.path.join("runs", "study_" + Path(args.study).stem)
         print(f"fsi_study: results in {args.out} (choose the folder with --out)", flush=True)
@@ -162,6 +163,8 @@ def cmd_run(args):
     out.mkdir(parents=True, exist_ok=True)
     copy = dict(study.raw)
     copy["scene"] = str(study.scene)  # the copy works from DIR (plot, analyse)
+    if study.fork:
+        copy["from"] = str(study.fork)
     if cli_sets:  # the copy names the runs as they were run (analyse)
         copy["fixed"] = dict(study.fixed)
     (out / "study.yaml").write_text(f"# copy of {study.path}\n" + yaml.safe_dump(copy, sort_keys=False))
@@ -253,6 +256,8 @@ def main(argv=None):
     r.add_argument("--plot", action="store_true", help="at the end, the study's PNGs into --out (as `plot DIR`)")
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="an override of every run, like the study's `fixed` (repeatable)")
+    r.add_argument("--from", dest="fork", default="", metavar="RUN_OR_CHECKPOINT",
+                   help="every run forks from this run's newest checkpoint (replaces the study's `from`)")
     r.add_argument("--dry-run", action="store_true",
                    help="check the keys, list the runs (folder and overrides) and run nothing")
     r.add_argument("--executor", choices=("local", "dask"), default="local",

@@ -73,9 +73,11 @@ def load_study_file(path, seen=()):
 
 
 class Study:
-    def __init__(self, path):
+    def __init__(self, path, fork=None):
         self.path = Path(path).resolve()
         d = load_study_file(self.path)
+        if fork:
+            d["from"] = str(Path(fork).resolve())
         unknown = sorted(set(d) - STUDY_KEYS)
         if unknown:
             raise StudyError(f"{path}: unknown key(s) {unknown}; known: {sorted(STUDY_KEYS)}")
@@ -85,7 +87,8 @@ class Study:
         if "scene" not in d:
             raise StudyError(f"{path}: 'scene' is required")
         self.scene = self._find(d["scene"])
-        self.fork = self._find_checkpoint(d["from"]) if d.get("from") else None
+        self.fork_given = d.get("from")
+        self.fork = self._find_checkpoint(self.fork_given) if self.fork_given else None
         self.fixed = {k: clean_value(v) for k, v in flatten(d.get("fixed")).items()}
         self.vary = {k: expand(k, v) for k, v in (d.get("vary") or {}).items()}
         self.zip = []
@@ -132,7 +135,11 @@ class Study:
         for c in ([p] if p.is_absolute() else [self.path.parent / p, Path.cwd() / p]):
             if c.is_dir():
                 return c.resolve()
-        raise StudyError(f"{self.path}: from '{given}': no such run or checkpoint folder")
+        return None  # checked before running (require_fork): `fsi check` and listings do without it
+
+    def require_fork(self):
+        if self.fork_given and self.fork is None:
+            raise StudyError(f"{self.path}: from '{self.fork_given}': no such run or checkpoint folder")
 
     def base_params(self):
         b = dict(self.scene_values)
