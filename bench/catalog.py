@@ -138,7 +138,7 @@ def cmd_compare(a):
         scene = Path(s["scene_file"])
         if not scene.is_absolute():
             scene = ROOT / scene
-        values = catalog_flatten(yaml.safe_load(scene.read_text()))
+        values = catalog._flat(yaml.safe_load(scene.read_text()))
         overrides = {k: yaml.safe_load(v) for k, v in (o.split("=", 1) for o in s.get("overrides", []))}
         wall = s["wall_time"]["total"] + float(s.get("wall_time_earlier_segments") or 0)
         e = catalog.estimate(scene.stem, values, overrides, data)
@@ -149,16 +149,6 @@ def cmd_compare(a):
         ratio = f"{e / wall:.2f}" if e else "-"
         print(f"{r[-50:]:<50} {scene.stem:<14} {wall:>9.1f}s {e or 0:>9.1f}s {ratio:>6}")
     return 0
-
-
-def catalog_flatten(d, prefix=""):
-    out = {}
-    for k, v in (d or {}).items():
-        if isinstance(v, dict):
-            out.update(catalog_flatten(v, f"{prefix}{k}."))
-        else:
-            out[f"{prefix}{k}"] = v
-    return out
 
 
 def main():

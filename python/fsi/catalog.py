@@ -64,6 +64,16 @@ def scene_info(path):
             "dt": dt, "end": end, "mesh_size": _get(d, "fluid.mesh.size")}
 
 
+def _flat(d, prefix=""):
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flat(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
 def scene_files():
     return sorted((REPO / "configs").glob("*.yaml"))
 
@@ -174,7 +184,8 @@ def rows(catalog):
     for f in scene_files():
         info = scene_info(f)
         entry = (catalog.get("scenes") or {}).get(info["name"])
-        info["wall_s"] = entry.get("wall_s") if entry else None
+        values = _flat(yaml.safe_load(Path(f).read_text()) or {})
+        info["wall_s"] = estimate(info["name"], values, {}, catalog)  # the scene as it is now (its steps)
         info["measured"] = entry
         scenes.append(info)
     studies = []
