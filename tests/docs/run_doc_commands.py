@@ -49,6 +49,8 @@ FSI3_AITKEN_SHORT = ("build/bin/fsi run configs/fsi3.yaml --out runs/fsi3_aitken
 FSI3_AITKEN = (f"build/bin/fsi run configs/fsi3.yaml --out runs/fsi3_aitken {COARSE_FSI3} --set coupling.acceleration=aitken "
                f"{INFLOW} --set fluid.interface.mesh_motion=elastic --set fluid.interface.mesh_incremental=true")
 RUN = {
+    "build/bin/fsi list": None,
+    "build/bin/fsi study studies/thin_beam.yaml --dry-run": None,
     "build/bin/fsi run configs/sdof_model.yaml --out runs/sdof": None,
     "build/bin/fsi run configs/sdof_model.yaml --out runs/g100 --set coupling.gamma_n1=100": None,
     "build/bin/fsi run configs/added_mass.yaml --out runs/am --set coupling.relaxation=0.17": None,
