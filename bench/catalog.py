@@ -13,10 +13,13 @@ machine, the commit and the date. A scene still running after --max-wall seconds
 is stopped (Ctrl-C, its folder stays consistent) and its whole-run time extrapolated from the
 steps done (marked `extrapolated`). Run it on an otherwise idle machine.
 
+refit: the cost model (start-up, seconds per step) of the entries from their run folders in --out.
+
 compare: for finished runs (summary.json with the scene and its overrides), the catalog's
 estimate against the run's own wall time, and the ratio.
 """
 import argparse
+import csv
 import datetime
 import json
 import os
@@ -68,6 +71,27 @@ def unknowns(run):
     return fluid, solid
 
 
+def cost_model(run, elapsed, steps_done):
+    """(start-up seconds, seconds per step) of a finished or stopped run: the mean step of
+    timing.csv after the first (coupled runs) and the rest of the elapsed time as start-up
+    (processes, meshing, configuring); a standalone run without timing.csv: the summary's
+    setup_seconds."""
+    try:
+        with open(run / "timing.csv") as f:
+            walls = [float(r["wall"]) for r in csv.DictReader(f)]
+    except (OSError, KeyError, ValueError):
+        walls = []
+    if len(walls) >= 3:  # the mean step after the first (which carries the start-up)
+        step = (walls[-1] - walls[0]) / (len(walls) - 1)
+        return max(0.0, elapsed - step * steps_done), step
+    try:
+        setup = float(json.loads((run / "summary.json").read_text()).get("setup_seconds") or 0.0)
+    except (OSError, ValueError):
+        setup = 0.0
+    setup = min(setup, elapsed)
+    return setup, (elapsed - setup) / max(1, steps_done)
+
+
 def measure_one(fsi, scene, out, max_wall):
     run = out / scene.stem
     cmd = [fsi, "run", str(scene), "--out", str(run), "--force"]
@@ -100,7 +124,9 @@ def measure_one(fsi, scene, out, max_wall):
     total_steps = info["steps"] or steps_done
     fluid, solid = unknowns(run)
     iterations = summary.get("coupling_iterations")
-    entry = {"wall_s": round(wall if not stopped else wall * total_steps / steps_done, 2),
+    startup, step = cost_model(run, wall, steps_done)
+    entry = {"wall_s": round(wall if not stopped else startup + step * total_steps, 2),
+             "startup_s": round(startup, 3), "step_s": round(step, 6),
              "measured_steps": steps_done if not stopped else total_steps,
              "steps": total_steps, "status": summary.get("status"),
              "iterations_per_step": round(iterations / steps_done, 2) if iterations else None,
@@ -126,6 +152,26 @@ def cmd_measure(a):
         data["measured"] = {"machine": machine(), "date": datetime.date.today().isoformat(), "commit": commit(),
                             "how": "bench/catalog.py measure: each scene as shipped, one solver job, idle machine"}
         catalog.CATALOG.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")  # after every scene
+    return 0
+
+
+def cmd_refit(a):
+    """The cost model (start-up, time per step) of catalog entries from their run folders in --out
+    (a catalog measured before the model was recorded)."""
+    data = catalog.load_catalog()
+    out = Path(a.out)
+    for name, e in data.get("scenes", {}).items():
+        run = out / name
+        if not (run / "summary.json").exists():
+            continue
+        m = re.search(r"from (\d+) of \d+ steps in ([\d.]+) s", e.get("extrapolated", ""))
+        elapsed, done = (float(m.group(2)), int(m.group(1))) if m else (float(e["wall_s"]), int(e["measured_steps"]))
+        startup, step = cost_model(run, elapsed, done)
+        e["startup_s"], e["step_s"] = round(startup, 3), round(step, 6)
+        if m:
+            e["wall_s"] = round(startup + step * int(e["steps"]), 2)
+        print(f"{name:14s} start-up {startup:7.2f} s, {step:.4g} s per step, whole run {e['wall_s']:.1f} s")
+    catalog.CATALOG.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
     return 0
 
 
@@ -159,10 +205,12 @@ def main():
     m.add_argument("--out", default=str(ROOT / "runs" / "catalog"))
     m.add_argument("--max-wall", type=float, default=600.0)
     m.add_argument("--fsi", default=os.environ.get("FSI_BIN", str(ROOT / "build" / "bin")) + "/fsi")
+    r = sub.add_parser("refit")
+    r.add_argument("--out", default=str(ROOT / "runs" / "catalog"))
     c = sub.add_parser("compare")
     c.add_argument("runs", nargs="+")
     a = ap.parse_args()
-    return {"measure": cmd_measure, "compare": cmd_compare}[a.cmd](a)
+    return {"measure": cmd_measure, "compare": cmd_compare, "refit": cmd_refit}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -5,11 +5,13 @@ The wall times come from configs/catalog.json, written by `bench/catalog.py meas
 scene run as shipped, one solver job on an otherwise idle machine (that machine, the commit and
 the date are in the file). An estimate for other settings scales the measured time per step:
 
-    wall = (measured wall / measured steps) * steps * (h_scene / h)^2
+    wall = start-up + (measured time per step) * steps * (h_scene / h)^2
 
-steps = time.end / time.dt of the run, h = fluid.mesh.size when a run overrides it (the fluid's
-unknowns grow as 1/h^2; the fluid is most of the cost of every fluid scene). Nothing else is
-scaled (coupling iterations, solid mesh, schemes): an estimate, good to a factor of about 2, and
+start-up: processes, meshing, configuring (measured); steps = (time.end - start) / time.dt of the
+run (start: 0, or the checkpoint's time of a run forked from one), h = fluid.mesh.size when a run overrides it (the fluid's
+unknowns grow as 1/h^2; the fluid is most of the cost of every fluid scene), and by k_max / the
+measured iterations per step when a run makes a fixed number of coupling iterations (tolerance 0).
+Nothing else is scaled (converged iterations, solid mesh, schemes): an estimate, good to a factor of about 2, and
 a study's run never counts longer than its time limit (it is stopped there).
 """
 import json
@@ -89,21 +91,29 @@ def _number(v):
         return None
 
 
-def estimate(scene_name, scene_values, overrides, catalog):
+def estimate(scene_name, scene_values, overrides, catalog, start_time=None):
     """Estimated wall seconds of one run of `scene_name` with `overrides` ({dotted key: value}),
-    or None when the scene was not measured. scene_values: the scene's own flattened values."""
+    or None when the scene was not measured. scene_values: the scene's own flattened values;
+    start_time: where a forked run starts (its checkpoint's time)."""
     entry = (catalog.get("scenes") or {}).get(scene_name)
     if not entry or not entry.get("measured_steps"):
         return None
-    per_step = float(entry["wall_s"]) / float(entry["measured_steps"])
+    startup = float(entry.get("startup_s") or 0.0)
+    per_step = float(entry.get("step_s") or (float(entry["wall_s"]) - startup) / float(entry["measured_steps"]))
     dt = _number(overrides.get("time.dt", scene_values.get("time.dt")))
     end = _number(overrides.get("time.end", scene_values.get("time.end")))
-    steps = max(1, int(round(end / dt))) if dt and end else int(entry.get("steps") or entry["measured_steps"])
+    start = _number(start_time) or 0.0
+    steps = max(1, int(round((end - start) / dt))) if dt and end else int(entry.get("steps") or entry["measured_steps"])
     scale = 1.0
     h0, h = _number(scene_values.get("fluid.mesh.size")), _number(overrides.get("fluid.mesh.size"))
     if h0 and h and h > 0:
         scale = (h0 / h) ** 2
-    return per_step * steps * scale
+    measured_its = _number(entry.get("iterations_per_step"))
+    kmax = _number(overrides.get("coupling.iterations.max"))
+    tolerance = _number(overrides.get("coupling.iterations.tolerance", scene_values.get("coupling.iterations.tolerance")))
+    if measured_its and kmax and tolerance == 0:  # a fixed number of coupling iterations: cost in proportion
+        scale *= min(kmax, max(measured_its, kmax)) / measured_its
+    return startup + per_step * steps * scale
 
 
 def study_estimate(study, catalog):
@@ -116,6 +126,7 @@ def study_estimate(study, catalog):
     st = study.stability or {}
     bis = st.get("bisection")
     runs, total, unknown = 0, 0.0, 0
+    start = fork_time(study.fork)
     specs = []
     if bis:
         lo, hi, tol = float(bis.get("lo", 0.0)), float(bis.get("hi", 1.0)), float(bis.get("tol", 0.005))
@@ -135,7 +146,7 @@ def study_estimate(study, catalog):
     for s in specs:
         overrides = dict(kv.split("=", 1) for kv in s["sets"])
         overrides = {k: _yaml_value(v) for k, v in overrides.items()}
-        e = estimate(name, scene_values, overrides, catalog)
+        e = estimate(name, scene_values, overrides, catalog, start)
         runs += 1
         if e is None:
             unknown += 1
@@ -143,6 +154,22 @@ def study_estimate(study, catalog):
         total += min(e, limit)
     how = "bisection worst case" if bis else "grid"
     return runs, (None if unknown == runs else total), unknown, how
+
+
+def fork_time(path):
+    """The time of the checkpoint a run forked from `path` starts at (a run folder: its newest
+    checkpoint), or None."""
+    if not path:
+        return None
+    p = Path(path)
+    manifests = [p / "manifest.json"] if (p / "manifest.json").exists() else \
+        sorted((p / "checkpoints").glob("step_*/manifest.json"))
+    for m in reversed(manifests):
+        try:
+            return float(json.loads(m.read_text())["time"])
+        except (OSError, ValueError, KeyError):
+            continue
+    return None
 
 
 def _yaml_value(v):
@@ -213,8 +240,12 @@ def print_list(data, out=sys.stdout):
     print(f"  {'NAME':<14} {'FLUID':<9} {'SOLID':<7} {'UNKNOWNS':<26} {'STEPS':>6} {'WALL':>12}  DESCRIPTION",
           file=out)
     for s in data["scenes"]:
+        wall = duration(s["wall_s"]) + ("*" if (s["measured"] or {}).get("extrapolated") else "")
         print(f"  {s['name']:<14} {s['fluid']:<9} {s['solid']:<7} {_unknowns(s['measured']):<26} "
-              f"{s['steps'] or '':>6} {duration(s['wall_s']):>12}  {_short(s['description'], 70)}", file=out)
+              f"{s['steps'] or '':>6} {wall:>12}  {_short(s['description'], 70)}", file=out)
+    if any((s["measured"] or {}).get("extrapolated") for s in data["scenes"]):
+        print("  * extrapolated from the run's first minutes: a long coupled run's developed phase costs more per "
+              "step (FSI2 P2/P1: 2.3x), so these are low", file=out)
     print("\nStudies (studies/; fsi study studies/NAME.yaml --out DIR; estimate: the runs one after the other, "
           "each capped at the study's time limit; divide by --jobs):", file=out)
     print(f"  {'NAME':<18} {'SCENE':<12} {'RUNS':>5} {'ESTIMATE':>12}  DESCRIPTION", file=out)

@@ -86,7 +86,7 @@ def dry_run(study, out, sources, n, check_how, jobs):
                 break
             i += 1
             overrides = {k: yaml.safe_load(v) for k, v in (x.split("=", 1) for x in s["sets"])}
-            e = catalog.estimate(scene, study.scene_values, overrides, measured)
+            e = catalog.estimate(scene, study.scene_values, overrides, measured, catalog.fork_time(study.fork))
             print(f"{i:4d}  {out / 'runs' / s['name']}")
             print("      " + " ".join(f"--set {x}" for x in s["sets"]))
             print(f"      about {catalog.duration(min(e, study.time_limit))}" if e is not None else
