@@ -554,6 +554,13 @@ void Coupler::load_restart(Run& r) {
     }
   }
   if (r.at_fork) {
+    // The steps are numbered from t = 0 (t_n = n dt): another dt would put the fork at another
+    // time and run to time.end in the wrong number of steps.
+    for (const auto& d : diffs)
+      if (d.rfind("time.dt:", 0) == 0)
+        throw Stop{"failed", fmt::format("--from {}: a fork keeps the time step ({}); start a run with another "
+                                         "time.dt from rest, or from another run's fluid state (--initial-state)",
+                                         restart.dir.string(), d)};
     r.data["forked_from"]["changed"] = diffs;
     for (const auto& d : diffs) r.log->info("forked with {}", d);
   } else if (!diffs.empty()) {

@@ -274,13 +274,17 @@ def fork(env):
     assert rows(os.path.join(changed, "probes.csv")) == 200 - s["forked_from"]["step"], s
     for n, b in before.items():
         assert read(os.path.join(ref, n)) == b, f"--from changed the original's {n}"
+    # Another time step would number the steps from another t = 0: refused, naming the key.
+    code, log = env.fsi("sdof_model.yaml", env.out("fork_dt"), "time.end=4", "time.dt=0.01", *sets[1:],
+                        extra=("--from", ref))
+    assert code == 1 and "a fork keeps the time step" in log and "time.dt" in log, log
     code, log = env.fsi("sdof_model.yaml", env.out("fork_bad"), *sets, extra=("--from", env.out("nowhere")))
     assert code == 1 and "--from" in log and "checkpoint" in log, log
     code, log = env.fsi("sdof_model.yaml", same, *sets, extra=("--from", ref, "--resume"))
     assert code == 1 and "exclude each other" in log, log
     print(f"fork: unchanged fork = the original's rows 101-200 byte for byte; gamma_N1 10 -> 100 forked from step "
-          f"{s['forked_from']['step']} and listed; the original untouched; a folder without checkpoints and "
-          f"--from with --resume refused")
+          f"{s['forked_from']['step']} and listed; the original untouched; another dt, a folder without checkpoints "
+          f"and --from with --resume refused")
 
 
 # ------------------------------------------------------------------------------ recovery
