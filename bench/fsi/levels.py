@@ -86,6 +86,19 @@ def status(path):
         return None
 
 
+def scene_end(case, element):
+    import yaml
+    return float(yaml.safe_load(open(os.path.join(ROOT, SCENES[(case, element)])))["time"]["end"])
+
+
+def run_end(path):
+    """time.end of a run folder (its summary's parameters), 0 when unknown."""
+    try:
+        return float(json.load(open(os.path.join(path, "summary.json")))["parameters"]["time"]["end"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0.0
+
+
 def cmd_run(a):
     fsi_bin = os.environ.get("FSI_BIN", os.path.join(ROOT, "build", "bin"))
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_WAIT_POLICY="passive")
@@ -93,11 +106,12 @@ def cmd_run(a):
     for lv in a.levels:
         d = run_dir(a.out, a.case, a.element, lv)
         st = status(d)
-        if st == "completed":
+        end = a.end or scene_end(a.case, a.element)
+        if st == "completed" and run_end(d) >= end - 1e-9:
             print(f"level {lv}: {d} completed, skipped")
-            continue
+            continue  # (a completed run with an earlier end is extended: --resume --set time.end)
         cmd = [os.path.join(fsi_bin, "fsi"), "run", SCENES[(a.case, a.element)], "--out", d]
-        for s in level_overrides(a.case, a.element, lv, a.solid_element, a.end):
+        for s in level_overrides(a.case, a.element, lv, a.solid_element, end):
             cmd += ["--set", s]
         if st is not None and os.path.isdir(os.path.join(d, "checkpoints")):
             cmd.append("--resume")
