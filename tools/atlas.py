@@ -199,9 +199,13 @@ def plot_work_precision(rows, png, title):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    pts = [r for r in rows if r["outcome"] == "completed" and not r["name"].startswith("reference")
+           and math.isfinite(r["_err"]) and math.isfinite(r["_wall"]) and r["_wall"] > 0]
+    if not pts:
+        return False  # nothing to draw (no converged reference, or nothing completed)
     fig, ax = plt.subplots(figsize=(7, 4.5))
     markers = "osD^v<>phX*"
-    for i, r in enumerate(r for r in rows if r["outcome"] == "completed" and not r["name"].startswith("reference")):
+    for i, r in enumerate(pts):
         ax.plot([r["_wall"]], [max(r["_err"], 1e-12)], marker=markers[i % len(markers)], linestyle="",
                 label=f"{r['scheme']} ({fmt(r['_its'])} it/step)")
     ax.set_xscale("log")
@@ -214,6 +218,7 @@ def plot_work_precision(rows, png, title):
     png.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(png, dpi=110)
     plt.close(fig)
+    return True
 
 
 def section_reference(name, out, page, study):
@@ -225,7 +230,7 @@ def section_reference(name, out, page, study):
     spec = yaml.safe_load(Path(study).read_text())
     fixed = spec.get("fixed") or {}
     png = page.parent / "img" / f"atlas_{name}.png"
-    plot_work_precision(rows, png, f"{title}: error against wall time")
+    drawn = plot_work_precision(rows, png, f"{title}: error against wall time")
     ref = [r for r in rows if r["name"].startswith("reference")]
     lines = [f"## {title} (`{scene}`, `{Path(study).relative_to(SRC) if Path(study).is_relative_to(SRC) else study}`)",
              "",
@@ -233,7 +238,8 @@ def section_reference(name, out, page, study):
              "coupled solution: the reference run, IQN-ILS iterated far below the others' tolerance (with",
              "the consistent Robin terms every converged scheme and algorithm reaches the same solution).",
              "The schemes, their relaxation, iterations and tolerances: the header of the study file.", "",
-             f"![error against wall time]({png.relative_to(page.parent)})", "",
+             f"![error against wall time]({png.relative_to(page.parent)})" if drawn else
+             "(No plot: no run has an error against a completed reference.)", "",
              "| scheme | outcome | iterations / step | wall s | rel. L2 error A_x | rel. L2 error A_y |",
              "|---|---|---|---|---|---|"]
     for r in rows:

@@ -3,6 +3,7 @@
 after the checkpoint's time, the runs with the scene's own settings continue the developed run
 exactly (byte-identical rows against running it on), and `from` is part of the runs' names."""
 import csv
+import json
 import subprocess
 
 from common import FSI, SRC, check, results, run_tool, work_dir
@@ -46,6 +47,11 @@ for r in rows:
     check(len(t) - 1 == 50, f"{r['name']}: 50 steps from t = 1 to 2 ({len(t) - 1})")
     if float(r["coupling.relaxation"]) == float(scene_beta):
         check(t[1:] == full[51:], f"{r['name']}: the scene's own settings continue the developed run exactly")
+for r in rows:  # the run's own steps and iterations (the developed run's 50 steps are not counted)
+    s = json.loads((w / "out" / "runs" / r["name"] / "summary.json").read_text())
+    want = (s["coupling_iterations"] - s["forked_from"]["iterations"]) / 50
+    check(int(r["steps"]) == 50 and abs(float(r["iterations_per_step"]) - want) < 1e-12,
+          f"{r['name']}: results.csv counts the fork's own 50 steps, {want:.3f} iterations per step")
 p = run_tool("run", str(study), "--out", str(w / "out"), "--fsi", FSI, "--jobs", "1")
 check("0 run(s) started, 2 done before" in p.stderr, "a second invocation runs nothing")
 names_without = {n.split("-")[-1] for n in (r["name"] for r in rows)}

@@ -204,6 +204,11 @@ class Runner:
                "cpu_time": finite(marker.get("cpu_time")),
                "wall_time": wall if wall is not None else finite(marker.get("elapsed")),
                "steps": (summary or {}).get("steps"), "coupling_iterations": (summary or {}).get("coupling_iterations")}
+        fork = (summary or {}).get("forked_from")
+        if isinstance(fork, dict) and rec["steps"] is not None and rec["coupling_iterations"] is not None:
+            # a forked run (study `from`): its own steps and iterations, not the developed run's
+            rec["steps"] = rec["steps"] - int(fork.get("step", 0))
+            rec["coupling_iterations"] = rec["coupling_iterations"] - int(fork.get("iterations", 0))
         if rec["steps"] and rec["coupling_iterations"] is not None:
             rec["iterations_per_step"] = rec["coupling_iterations"] / rec["steps"]
         for k in ("worker", "attempts"):  # Dask executor: where it ran, how many tries it took
