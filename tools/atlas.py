@@ -237,7 +237,9 @@ def section_reference(name, out, page, study):
              f"{what[0].upper() + what[1:]}, up to t = {fixed.get('time.end', '?')}. Each scheme against the converged",
              "coupled solution: the reference run, IQN-ILS iterated far below the others' tolerance (with",
              "the consistent Robin terms every converged scheme and algorithm reaches the same solution).",
-             "The schemes, their relaxation, iterations and tolerances: the header of the study file.", "",
+             "The schemes, their relaxation, iterations and tolerances: the header of the study file.",
+             "Wall times: one run at a time with one core for it (`--jobs 1` beside another job), so a",
+             "parallel (Jacobi) run's fluid and solid shared that core: not its two-core wall time.", "",
              f"![error against wall time]({png.relative_to(page.parent)})" if drawn else
              "(No plot: no run has an error against a completed reference.)", "",
              "| scheme | outcome | iterations / step | wall s | rel. L2 error A_x | rel. L2 error A_y |",
