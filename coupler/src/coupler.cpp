@@ -753,21 +753,28 @@ Coupler::Step Coupler::begin_step(Run& r, int n) {
   return step;
 }
 
+// The start of a coupling iteration, serial or parallel: a signal stops here; Algorithm 2's
+// damping operator of this solve (H^T M_f H of the fluid's last solve, consistent, or the
+// solid's own int N^T N) handed to the solid.
+Coupler::Update Coupler::begin_iteration(Run& r, const Step& step) {
+  if (interrupt_flag())
+    throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", step.n, step.k)};
+  Update u;
+  u.iterate.damping = solid_damping_mass(r.state.mapped_mass);
+  if (consistent_damping_ && r.state.mapped_mass.rows() > 0) {
+    Timer t(times_.solid);
+    solid_.set_interface_mass(u.iterate.damping);
+  }
+  return u;
+}
+
 Coupler::Update Coupler::coupling_iteration(Run& r, Step& step) {
   if (settings_.scheme == CouplingScheme::Parallel) return parallel_iteration(r, step);
   const int n = step.n, k = step.k;
   const double gamma = r.gamma;
-  if (interrupt_flag()) throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
   const StepInfo info{step.t_np1, r.time.dt, n, k};
-  Update u;
+  Update u = begin_iteration(r, step);
   Iterate& it = u.iterate;
-  // Algorithm 2: the damping operator of this solve: H^T M_f H of the fluid's last solve
-  // (consistent), or the solid's own int N^T N.
-  it.damping = solid_damping_mass(r.state.mapped_mass);
-  if (consistent_damping_ && r.state.mapped_mass.rows() > 0) {
-    Timer t(times_.solid);
-    solid_.set_interface_mass(it.damping);
-  }
   const SolidStepResult& s = it.s;
   {
     Timer t(times_.solid);
@@ -840,15 +847,9 @@ double Coupler::parallel_gap_limit() const {
 // [d_s - d^(k); v_s - v^(k); -F*(x^(k)) - F^(k)].
 Coupler::Update Coupler::parallel_iteration(Run& r, Step& step) {
   const int n = step.n, k = step.k;
-  if (interrupt_flag()) throw Stop{"interrupted", fmt::format("interrupted by a signal at step {} iteration {}", n, k)};
   const StepInfo info{step.t_np1, r.time.dt, n, k};
-  Update u;
+  Update u = begin_iteration(r, step);
   Iterate& it = u.iterate;
-  it.damping = solid_damping_mass(r.state.mapped_mass);
-  if (consistent_damping_ && r.state.mapped_mass.rows() > 0) {
-    Timer t(times_.solid);
-    solid_.set_interface_mass(it.damping);
-  }
   Eigen::VectorXd v_f;
   {
     Timer t(times_.coupler);

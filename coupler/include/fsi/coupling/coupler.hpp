@@ -115,8 +115,9 @@ class Coupler {
   void open_tables(Run& r);
   // 3. One step: its iterations, then accept.
   Step begin_step(Run& r, int n);
-  Update coupling_iteration(Run& r, Step& step);  // solid, fluid, F*, residual, F^(k+1)
-  Update parallel_iteration(Run& r, Step& step);  // solid and fluid at once, x^(k+1)
+  Update begin_iteration(Run& r, const Step& step);  // signal check, Algorithm 2's damping to the solid
+  Update coupling_iteration(Run& r, Step& step);     // solid, fluid, F*, residual, F^(k+1)
+  Update parallel_iteration(Run& r, Step& step);     // solid and fluid at once, x^(k+1)
   void stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force);
   void measure(Step& step, Update& u, const Eigen::VectorXd& traction_change) const;  // residual quantities
   double parallel_gap_limit() const;                     // the interface state's convergence limit
