@@ -99,6 +99,28 @@ def level_errors(stats, refs):
 err = fstats.relative_error_percent
 
 
+def featflow_limits(case):
+    """FEATFLOW's own levels 2, 3, 4 (h halved per level) Richardson-extrapolated, per quantity
+    and part: {q: {"mean"|"amplitude": {"limit", "order", "vs_level4" (%)} or None}}. None where
+    the sequence is not monotonically convergent (FSI3's, the near-zero means), so there is no
+    extrapolated value; a part equal on all three levels (the FSI2 frequencies) is its own limit."""
+    out = {}
+    for q in COLUMNS:
+        out[q] = {}
+        for i, part in enumerate(("mean", "amplitude")):
+            v = [LEVELS[case][lv][q][i] for lv in (2, 3, 4)]
+            if part == "mean" and q in NEAR_ZERO_MEAN:
+                out[q][part] = None
+                continue
+            try:
+                r = fstats.richardson(v)
+            except fstats.StatsError:
+                out[q][part] = None
+                continue
+            out[q][part] = {"limit": r["limit"], "order": r["order"], "vs_level4": err(r["limit"], v[2])}
+    return out
+
+
 def plot(a, t, d, ref):
     """PNG of A's displacement and the forces over time, FEATFLOW's band (mean +/- amplitude) shaded."""
     import matplotlib

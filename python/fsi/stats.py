@@ -494,3 +494,22 @@ def compare_values(t, y, values, window=None, steady_fraction=0.1):
 def relative_error_percent(ours, ref):
     """100 (ours - ref) / |ref|; NaN for ref = 0."""
     return 100.0 * (ours - ref) / abs(ref) if ref else float("nan")
+
+
+def richardson(values, ratio=2.0):
+    """Richardson extrapolation of a quantity computed on three meshes, coarse to fine, each
+    refined by `ratio` in h (Roache's grid-convergence analysis): the observed order
+    p = log(|f1 - f2| / |f2 - f3|) / log(ratio) and the extrapolated limit
+    f3 + (f3 - f2) / (ratio^p - 1). Only for monotone convergence (the two differences of the
+    same sign, the finer one smaller); otherwise (oscillating or diverging sequences, where the
+    extrapolation means nothing) StatsError. Returns {"limit", "order", "ratio"}: "ratio" is
+    d_fine / d_coarse."""
+    if len(values) != 3:
+        raise StatsError(f"richardson needs three levels (got {len(values)})")
+    f1, f2, f3 = (float(v) for v in values)
+    d1, d2 = f2 - f1, f3 - f2
+    if d1 == 0.0 or d2 == 0.0 or (d1 > 0) != (d2 > 0) or abs(d2) >= abs(d1):
+        raise StatsError(f"not monotonically convergent ({f1:g}, {f2:g}, {f3:g}): no extrapolation")
+    r = d2 / d1
+    p = math.log(1.0 / r) / math.log(ratio)
+    return {"limit": f3 + d2 * r / (1.0 - r), "order": p, "ratio": r}

@@ -3,7 +3,8 @@
 elements), and the level table on synthetic runs whose histories are sines with known errors
 against FEATFLOW's level 4 reports those errors, the wall time per simulated second from
 timing.csv and the self-convergence between the two finest levels; a missing level and one
-shorter than 3 periods are reported as such."""
+shorter than 3 periods are reported as such; FEATFLOW's own FSI2 levels Richardson-extrapolated
+to the limits computed by hand, FSI3's (not monotone) not extrapolated."""
 import json
 import math
 import os
@@ -79,6 +80,20 @@ with tempfile.TemporaryDirectory() as tmp:
     sc = [l for l in md.splitlines() if l.startswith("Self-convergence, levels 1 -> 2")]
     want = 100 * abs((1 + amp_err[2]) - (1 + amp_err[1])) / (1 + amp_err[2])
     check(len(sc) == 1 and f"uy amplitude {want:.2f} %" in sc[0], f"self-convergence u_y amplitude {want:.2f} %: {sc}")
+    check("converge monotonically in no mean or amplitude" in md, "FSI3: FEATFLOW's levels not monotone, no extrapolation")
+
+    # FEATFLOW's FSI2 levels 2-4 extrapolated by hand: u_y amplitude 79.2, 80.7, 81.6 (differences
+    # 1.5, 0.9: ratio 0.6) -> 81.6 + 0.9 * 0.6 / 0.4 = 82.95, order log2(1 / 0.6); the drag
+    # amplitude 72.86, 75.74, 77.65 -> 77.65 + 1.91 * r / (1 - r), r = 1.91 / 2.88
+    lim = th_stats.featflow_limits("fsi2")
+    check(abs(lim["uy"]["amplitude"]["limit"] - 82.95) < 1e-9, f"FSI2 u_y amplitude limit {lim['uy']['amplitude']}")
+    check(abs(lim["uy"]["amplitude"]["order"] - math.log2(1 / 0.6)) < 1e-9, "FSI2 u_y amplitude order log2(1/0.6)")
+    r_d = 1.91 / 2.88
+    check(abs(lim["drag"]["amplitude"]["limit"] - (77.65 + 1.91 * r_d / (1 - r_d))) < 1e-9,
+          f"FSI2 drag amplitude limit {lim['drag']['amplitude']}")
+    check(lim["uy"]["mean"] is None and lim["lift"]["mean"] is None, "no limit for the near-zero means")
+    check(all(v is None for q in th_stats.featflow_limits("fsi3").values() for k, v in q.items() if k == "amplitude"),
+          "FSI3: no amplitude limit (FEATFLOW's levels not monotone)")
     # a level with fewer than 3 whole periods is listed as refused
     d = Path(tmp) / "fsi3_p2p1_L3"
     d.mkdir()

@@ -163,4 +163,20 @@ except S.StatsError as e:
 ma = S.moving_average([0, 1, 2, 3, 4], [0, 0, 3, 0, 0], 2.0)
 check(np.allclose(ma, [0, 1, 1, 1, 0]), f"moving_average of a spike over 3 samples: {ma}")
 
+# --- Richardson extrapolation: f(h) = 10 + 3 h^1.5 on h = 1, 1/2, 1/4 gives the limit 10 and
+# the order 1.5 exactly; a sequence converging from above likewise; oscillating, diverging or
+# stagnating sequences are refused
+rx = S.richardson([10 + 3 * h ** 1.5 for h in (1.0, 0.5, 0.25)])
+close(rx["limit"], 10.0, 1e-12, "richardson limit of 10 + 3 h^1.5")
+close(rx["order"], 1.5, 1e-12, "richardson observed order 1.5")
+rx = S.richardson([5 - 2 * h ** 0.6 for h in (0.4, 0.2, 0.1)])
+close(rx["limit"], 5.0, 1e-12, "richardson limit from below, order 0.6")
+close(rx["order"], 0.6, 1e-12, "richardson observed order 0.6")
+for bad in ([1.0, 2.0, 1.5], [1.0, 2.0, 3.5], [1.0, 1.0, 1.0], [1.0, 2.0]):
+    try:
+        S.richardson(bad)
+        check(False, f"richardson refuses {bad}")
+    except S.StatsError as e:
+        check(True, f"richardson refuses {bad}: {e}")
+
 sys.exit(1 if failures else 0)
