@@ -403,7 +403,7 @@ void FlowSolver::assemble(const Step& step, const Eigen::VectorXd& U_lin, StepRe
     const auto& m = mesh();
     const Eigen::RowVector2d centre =
         (X_.row(m.triangles(e, 0)) + X_.row(m.triangles(e, 1)) + X_.row(m.triangles(e, 2))) / 3.0;
-    throw SolverError(
+    throw MeshTangled(
         fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}) is {}; the mesh motion "
                     "tangled the mesh",
                     step.time, im.element->cell_name(), e, centre(0), centre(1), im.element->inverted(bad)));

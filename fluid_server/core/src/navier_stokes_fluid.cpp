@@ -496,10 +496,11 @@ void NavierStokesFluid::remesh(const StepInfo& info, const std::string& why) {
                     "would not fit",
                     info.step, oi.size(), ni.size()));
   const TransferReport transfer = fresh->transfer_state(old, r.old_node);
-  if (motion_ && last_interface_displacement_.size() > 0) {
-    if (remesh_offset_.size() != last_interface_displacement_.size())
-      remesh_offset_ = Eigen::VectorXd::Zero(last_interface_displacement_.size());
-    remesh_offset_ += last_interface_displacement_;
+  if (motion_ && accepted_interface_displacement_.size() > 0) {  // the mesh is remeshed as accepted
+    if (remesh_offset_.size() != accepted_interface_displacement_.size())
+      remesh_offset_ = Eigen::VectorXd::Zero(accepted_interface_displacement_.size());
+    remesh_offset_ += accepted_interface_displacement_;
+    accepted_interface_displacement_.setZero();
     last_interface_displacement_.setZero();
   }
   const int old_nodes = old.mesh().node_count();
@@ -562,6 +563,7 @@ void index_matrix(const StateArchive& state, const std::string& name, M& m, Eige
 void NavierStokesFluid::save_remeshed(StateArchive& state) const {
   const auto& m = solver_->mesh();
   state.put("remesh.count", static_cast<std::int64_t>(remeshes_));
+  if (remesh_retries_ > 0) state.put("remesh.retries", static_cast<std::int64_t>(remesh_retries_));
   state.put("remesh.offset", remesh_offset_);
   state.put("remesh.quality", remesh_quality_);
   state.put("remesh.size", remesh_size_);
@@ -594,6 +596,7 @@ void NavierStokesFluid::load_remeshed(const StateArchive& state) {
   solver_ = make_solver(std::move(mesh), solver_->parameters());
   if (motion_) build_mesh_motion();
   remeshes_ = static_cast<int>(count);
+  remesh_retries_ = state.has("remesh.retries") ? static_cast<int>(state.integer("remesh.retries")) : 0;
   remesh_offset_ = count > 0 ? state.vector("remesh.offset") : Eigen::VectorXd();
   remesh_quality_ = count > 0 ? state.real("remesh.quality") : 1.0;
   remesh_size_ = count > 0 ? state.vector("remesh.size") : Eigen::VectorXd();
@@ -686,23 +689,45 @@ FluidLoads NavierStokesFluid::initial_loads(const Eigen::VectorXd&, const Eigen:
   return loads;
 }
 
-FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
-                                         const Eigen::VectorXd& interface_velocity) {
-  const auto t0 = std::chrono::steady_clock::now();
+// One solve on the current mesh, moved by the interface displacement (after a remesh measured
+// from the mesh of the remesh).
+void NavierStokesFluid::solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                                      const Eigen::VectorXd& interface_velocity) {
   Eigen::MatrixX2d positions = solver_->mesh().nodes;
   if (motion_ && interface_displacement.size() > 0) {
-    // After a remesh the reference is the mesh of the remesh: the displacement from there.
     const Eigen::VectorXd d = remesh_offset_.size() == interface_displacement.size()
                                   ? Eigen::VectorXd(interface_displacement - remesh_offset_)
                                   : interface_displacement;
     positions += extend(d);
     last_interface_displacement_ = d;
   }
+  last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
+}
+
+FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                                         const Eigen::VectorXd& interface_velocity) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto where = [&](const std::exception& e) {
+    return fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration,
+                       e.what());
+  };
   try {
-    last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
+    try {
+      solve_on_mesh(info, interface_displacement, interface_velocity);
+    } catch (const MeshTangled& e) {
+      // The step's motion folded an element of a mesh that was valid at the step's start (the
+      // quality check between steps came too late: one step moved the interface that far).
+      // With remeshing on: remesh the step-start mesh once and solve this iteration again on
+      // the new mesh; a second fold in the same step is an error.
+      if (!remesh_.enabled || !motion_ || retried_step_ == info.step) throw;
+      fsi::logger("fluid")->warn("fluid: {}; remeshing the step-start mesh and solving again", where(e));
+      retried_step_ = info.step;
+      remesh(info, "the step's mesh motion inverted an element");
+      ++remesh_retries_;
+      solve_on_mesh(info, interface_displacement, interface_velocity);
+    }
   } catch (const SolverError& e) {
-    throw SolverError(
-        fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration, e.what()));
+    throw SolverError(where(e));
   }
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ++solves_;
@@ -727,6 +752,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
   solver_->accept();
   if (motion_ && last_interface_displacement_.size() > 0) motion_->accept(motion_input(last_interface_displacement_));
+  accepted_interface_displacement_ = last_interface_displacement_;
   std::map<std::string, double> probes;
   for (const auto& f : forces_) {
     const Eigen::Vector2d force = solver_->force(f.groups);
@@ -820,6 +846,8 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
   solver_->load_state(state, "flow.");
   if (motion_) motion_->load_state(state, "mesh.");
   last_interface_displacement_ = last;
+  accepted_interface_displacement_ = last;  // checkpoints are written between steps
+  retried_step_ = -1;
   factorisations_ = static_cast<int>(factorisations);
   solves_ = static_cast<int>(solves);
 }

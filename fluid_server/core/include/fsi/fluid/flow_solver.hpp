@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/solver_model.hpp"
 #include "fsi/common/state.hpp"
 #include "fsi/fluid/mesh.hpp"
 
@@ -36,6 +37,13 @@ struct TransferReport;  // field_transfer.hpp
 using VelocityFunction = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
 
 enum class TimeScheme { Steady, BDF1, BDF2 };
+
+// The mesh motion of a step folded an element of the moving mesh (the step's positions, not the
+// accepted ones): a SolverError that remeshing the step-start mesh may cure.
+class MeshTangled : public SolverError {
+ public:
+  using SolverError::SolverError;
+};
 
 struct StabilisationParameters {
   bool supg = true;

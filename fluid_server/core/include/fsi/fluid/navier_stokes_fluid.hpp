@@ -74,6 +74,7 @@ class NavierStokesFluid : public FluidModel {
                                     {"linear_solve", linear_solve_seconds_},
                                     {"step", solve_seconds_}};
     if (remeshes_ > 0) t["remesh"] = remesh_seconds_, t["remeshes"] = remeshes_;  // "remeshes": a count
+    if (remesh_retries_ > 0) t["remesh_retries"] = remesh_retries_;  // of those, steps solved again (a count)
     return t;
   }
   // Unknowns, mesh nodes and triangles (summary.json of standalone runs).
@@ -140,7 +141,12 @@ class NavierStokesFluid : public FluidModel {
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
   int factorisations_ = 0;                       // cumulative
-  Eigen::VectorXd last_interface_displacement_;  // of the last solve (for the mesh motion's accept)
+  Eigen::VectorXd last_interface_displacement_;      // of the last solve (for the mesh motion's accept)
+  Eigen::VectorXd accepted_interface_displacement_;  // of the last accepted step (a remesh's new offset)
+  int retried_step_ = -1;
+  int remesh_retries_ = 0;                            // the step whose tangled motion was remeshed and retried
+  void solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                     const Eigen::VectorXd& interface_velocity);
 };
 
 }  // namespace fsi::fluid
