@@ -150,7 +150,7 @@ def cmd_measure(a):
             continue
         data["scenes"][scene.stem] = entry
         data["measured"] = {"machine": machine(), "date": datetime.date.today().isoformat(), "commit": commit(),
-                            "how": "bench/catalog.py measure: each scene as shipped, one solver job, idle machine"}
+                            "how": "bench/catalog.py measure: each scene as shipped, one solver job per core"}
         catalog.CATALOG.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")  # after every scene
     return 0
 
