@@ -4,6 +4,7 @@ configs/catalog.json.
 
 Usage:
   /usr/bin/python3 bench/catalog.py measure [SCENE ...] [--out DIR] [--max-wall S] [--fsi PATH]
+  /usr/bin/python3 bench/catalog.py study STUDY_DIR ...      whole studies measured (their folders)
   /usr/bin/python3 bench/catalog.py compare RUN_DIR ...     estimates against runs' measured wall times
 
 measure: each scene (default: every configs/*.yaml) run as shipped (`fsi run configs/S.yaml
@@ -15,8 +16,12 @@ steps done (marked `extrapolated`). Run it on an otherwise idle machine.
 
 refit: the cost model (start-up, seconds per step) of the entries from their run folders in --out.
 
+study: whole studies measured from their finished folders (`fsi study ... --out DIR`): the runs'
+elapsed seconds summed, recorded when the folder ran the study that studies/ holds now; `fsi
+list` shows those instead of an estimate.
+
 compare: for finished runs (summary.json with the scene and its overrides), the catalog's
-estimate against the run's own wall time, and the ratio.
+estimate against the run's own wall time (a fork's own segment), and the ratio.
 """
 import argparse
 import csv
@@ -155,6 +160,46 @@ def cmd_measure(a):
     return 0
 
 
+def _resolved(study_dir, key, value):
+    """A study's scene / from path made absolute (a study folder's copy holds them resolved)."""
+    if key in ("scene", "from") and isinstance(value, str) and not os.path.isabs(value):
+        return str((Path(study_dir) / value).resolve())
+    return value
+
+
+def cmd_study(a):
+    """Whole studies measured: each folder's runs (results.json, their elapsed seconds summed:
+    one run after the other) recorded under studies.NAME when the folder's study is the one in
+    studies/ now (the same keys and values, paths resolved); otherwise refused and left out."""
+    import yaml
+    data = catalog.load_catalog()
+    data.setdefault("studies", {})
+    rc = 0
+    for folder in a.folders:
+        folder = Path(folder)
+        ran = yaml.safe_load((folder / "study.yaml").read_text())
+        name = ran.get("study")
+        shipped = Path(a.studies) / f"{name}.yaml"
+        if not shipped.exists():
+            print(f"{folder}: study '{name}' is not in {a.studies}")
+            rc = 1
+            continue
+        now = yaml.safe_load(shipped.read_text())
+        differ = sorted(k for k in set(ran) | set(now)
+                        if _resolved(shipped.parent, k, now.get(k)) != _resolved(folder, k, ran.get(k)))
+        if differ:
+            print(f"{folder}: not the study of {shipped} now (keys {', '.join(differ)} differ): not recorded")
+            rc = 1
+            continue
+        runs = json.loads((folder / "results.json").read_text())["runs"]
+        wall = sum(float(r.get("elapsed") or 0.0) for r in runs)
+        data["studies"][name] = {"runs": len(runs), "wall_s": round(wall, 1), "date": datetime.date.fromtimestamp(
+            (folder / "results.json").stat().st_mtime).isoformat(), "commit": commit()}
+        print(f"{name}: {len(runs)} runs, {wall:.1f} s one after the other")
+    catalog.CATALOG.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
+    return rc
+
+
 def cmd_refit(a):
     """The cost model (start-up, time per step) of catalog entries from their run folders in --out
     (a catalog measured before the model was recorded)."""
@@ -186,12 +231,15 @@ def cmd_compare(a):
             scene = ROOT / scene
         values = catalog._flat(yaml.safe_load(scene.read_text()))
         overrides = {k: yaml.safe_load(v) for k, v in (o.split("=", 1) for o in s.get("overrides", []))}
-        wall = s["wall_time"]["total"] + float(s.get("wall_time_earlier_segments") or 0)
+        forked = Path(r) / "forked_from.json"
+        own_from = json.loads(forked.read_text()).get("step", 0) if forked.exists() else 0
+        # a fork: its own segment only (its summary also carries the original's time and steps)
+        wall = s["wall_time"]["total"] + (0.0 if forked.exists() else float(s.get("wall_time_earlier_segments") or 0))
         e = catalog.estimate(scene.stem, values, overrides, data)
         if e is not None and s.get("steps"):
             dt = float(overrides.get("time.dt", values.get("time.dt")))
             end = float(overrides.get("time.end", values.get("time.end")))
-            e *= s["steps"] / max(1, round(end / dt))  # the steps this run made
+            e *= (s["steps"] - own_from) / max(1, round(end / dt))  # the steps this run made
         ratio = f"{e / wall:.2f}" if e else "-"
         print(f"{r[-50:]:<50} {scene.stem:<14} {wall:>9.1f}s {e or 0:>9.1f}s {ratio:>6}")
     return 0
@@ -207,10 +255,13 @@ def main():
     m.add_argument("--fsi", default=os.environ.get("FSI_BIN", str(ROOT / "build" / "bin")) + "/fsi")
     r = sub.add_parser("refit")
     r.add_argument("--out", default=str(ROOT / "runs" / "catalog"))
+    st = sub.add_parser("study")
+    st.add_argument("folders", nargs="+")
+    st.add_argument("--studies", default=str(ROOT / "studies"), help="where the shipped studies are")
     c = sub.add_parser("compare")
     c.add_argument("runs", nargs="+")
     a = ap.parse_args()
-    return {"measure": cmd_measure, "compare": cmd_compare, "refit": cmd_refit}[a.cmd](a)
+    return {"measure": cmd_measure, "compare": cmd_compare, "refit": cmd_refit, "study": cmd_study}[a.cmd](a)
 
 
 if __name__ == "__main__":

@@ -2,8 +2,9 @@
 description, solvers, unknowns and measured wall time) and the estimates of `fsi study --dry-run`.
 
 The wall times come from configs/catalog.json, written by `bench/catalog.py measure`: every
-scene run as shipped, one solver job on an otherwise idle machine (that machine, the commit and
-the date are in the file). An estimate for other settings scales the measured time per step:
+scene run as shipped, whole, one solver job per core (that machine, the commit and the date
+are in the file); studies run whole are recorded by `bench/catalog.py study` and listed as
+measured. An estimate for other settings scales the measured time per step:
 
     wall = start-up + (measured time per step) * steps * (h_scene / h)^2
 
@@ -11,7 +12,9 @@ start-up: processes, meshing, configuring (measured); steps = (time.end - start)
 run (start: 0, or the checkpoint's time of a run forked from one), h = fluid.mesh.size when a run overrides it (the fluid's
 unknowns grow as 1/h^2; the fluid is most of the cost of every fluid scene), and by k_max / the
 measured iterations per step when a run makes a fixed number of coupling iterations (tolerance 0).
-Nothing else is scaled (converged iterations, solid mesh, schemes): an estimate, good to a factor of about 2, and
+Nothing else is scaled (converged iterations, solid mesh, schemes): an estimate, good to a factor
+of about 2 for runs that iterate like the scene (not for other coupling schemes: constant
+relaxation on FSI3 took 30x the scene's iterations; hence measured studies), and
 a study's run never counts longer than its time limit (it is stopped there).
 """
 import json
@@ -223,6 +226,9 @@ def rows(catalog):
             runs, total, unknown, how = study_estimate(s, catalog)
             row.update(description=s.description, scene=Path(s.scene).stem, runs=runs, estimate_s=total,
                        not_measured=unknown, count=how, time_limit=s.time_limit)
+            whole = (catalog.get("studies") or {}).get(f.stem)
+            if whole and (how != "grid" or whole.get("runs") == runs):  # measured whole (bench/catalog.py study)
+                row["measured_s"] = whole.get("wall_s")
         except StudyError as e:
             row.update(description="", error=str(e))
         studies.append(row)
@@ -254,8 +260,14 @@ def print_list(data, out=sys.stdout):
             print(f"  {s['name']:<18} invalid: {s['error']}", file=out)
             continue
         runs = f"<={s['runs']}" if s["count"] != "grid" else str(s["runs"])
-        est = duration(s["estimate_s"]) + ("*" if s["not_measured"] and s["estimate_s"] is not None else "")
+        if s.get("measured_s") is not None:
+            est = duration(s["measured_s"]) + " m"
+        else:
+            est = duration(s["estimate_s"]) + ("*" if s["not_measured"] and s["estimate_s"] is not None else "")
         print(f"  {s['name']:<18} {s['scene']:<12} {runs:>5} {est:>12}  {_short(s['description'], 70)}", file=out)
+    if any(s.get("measured_s") is not None for s in data["studies"]):
+        print("  m: the whole study measured on the catalog's machine (bench/catalog.py study), not estimated",
+              file=out)
     if any(s.get("not_measured") and s.get("estimate_s") is not None for s in data["studies"]):
         print("  * some runs of the study have no measured scene and are not counted", file=out)
 

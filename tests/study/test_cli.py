@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """fsi study's options: --dry-run (lists runs and folders, runs nothing), --set (an override of
 every run: new names, the copy names it), an unknown key refused before anything runs (named,
-with the close match), exit 1 when every case failed, the progress line with ETA, CPU time."""
+with the close match), exit 1 when every case failed, the progress line with ETA, CPU time;
+`bench/catalog.py study` records a finished study folder's total when it ran the shipped study
+and refuses one run with other settings."""
 import json
 import os
 import re
@@ -102,3 +104,22 @@ check(len(calls) == 2 and calls[1].startswith(f"check {SRC.resolve()}/configs/sd
       f"fsi check SCENE --set ... called with the first run's overrides ({calls[1][:60]}...)")
 p = run_tool("run", str(study), "--out", str(w / "chk"), "--fsi", str(wrap), "--dry-run")
 check(p.returncode == 0 and "keys checked (fsi check)" in p.stdout, "accepted by fsi check: the dry run says so")
+
+# bench/catalog.py study: a folder that ran the study as it is -> its runs' elapsed seconds summed
+# into the catalog (fsi list shows them as measured); a folder run with --set -> refused.
+shipped = w / "shipped"
+shipped.mkdir(exist_ok=True)
+(shipped / "s.yaml").write_text(study.read_text())
+plain = w / "plain"
+run_tool("run", str(study), "--out", str(plain), "--fsi", FSI)
+catalog.write_text('{"measured": {"machine": "test"}, "scenes": {}}')
+env = dict(os.environ, FSI_CATALOG=str(catalog))
+cat = [("/usr/bin/python3"), str(SRC / "bench" / "catalog.py"), "study", "--studies", str(shipped)]
+p = subprocess.run(cat + [str(plain)], capture_output=True, text=True, timeout=60, env=env)
+want = sum(float(r["elapsed"]) for r in json.loads((plain / "results.json").read_text())["runs"])
+got = json.loads(catalog.read_text()).get("studies", {}).get("s", {})
+check(p.returncode == 0 and got.get("runs") == 6 and abs(got.get("wall_s", -1) - want) <= 0.05,
+      f"catalog.py study records 6 runs, {want:.2f} s ({p.returncode}, {got}, {p.stdout.strip()})")
+p = subprocess.run(cat + [str(out)], capture_output=True, text=True, timeout=60, env=env)
+check(p.returncode == 1 and "not the study of" in p.stdout and "fixed" in p.stdout,
+      f"a folder run with --set is refused, the differing key named: {p.stdout.strip()}")
