@@ -225,7 +225,10 @@ def main():
             print(f"status {s.get('status')}; wall time {tot:.1f} s: {parts}")
             for k, v in w.items():
                 if isinstance(v, dict):
-                    print(f"  {k}: " + ", ".join(f"{n} {x:.1f} s ({100 * x / tot:.2f}% of the total)" for n, x in v.items()))
+                    counts = ("remeshes", "remesh_retries")  # counts, not seconds
+                    print(f"  {k}: " + ", ".join(f"{n} {x:.0f}" if n in counts else
+                                                 f"{n} {x:.1f} s ({100 * x / tot:.2f}% of the total)"
+                                                 for n, x in v.items()))
     if a.json:
         json.dump(result, open(a.json, "w"), indent=2)
     if a.plot:
