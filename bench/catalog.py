@@ -162,8 +162,8 @@ def cmd_measure(a):
 
 def _resolved(study_dir, key, value):
     """A study's scene / from path made absolute (a study folder's copy holds them resolved)."""
-    if key in ("scene", "from") and isinstance(value, str) and not os.path.isabs(value):
-        return str((Path(study_dir) / value).resolve())
+    if key in ("scene", "from") and isinstance(value, str):
+        return str((Path(study_dir) / value).resolve())  # an absolute value stays itself, normalised
     return value
 
 

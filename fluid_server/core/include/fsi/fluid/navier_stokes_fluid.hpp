@@ -140,11 +140,11 @@ class NavierStokesFluid : public FluidModel {
   double assembly_seconds_ = 0, factor_seconds_ = 0, linear_solve_seconds_ = 0;
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
-  int factorisations_ = 0;                       // cumulative
+  int factorisations_ = 0;                           // cumulative
   Eigen::VectorXd last_interface_displacement_;      // of the last solve (for the mesh motion's accept)
   Eigen::VectorXd accepted_interface_displacement_;  // of the last accepted step (a remesh's new offset)
   int retried_step_ = -1;
-  int remesh_retries_ = 0;                            // the step whose tangled motion was remeshed and retried
+  int remesh_retries_ = 0;  // the step whose tangled motion was remeshed and retried
   void solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                      const Eigen::VectorXd& interface_velocity);
 };
