@@ -30,14 +30,8 @@ FSI = str(Path(a.bin).resolve() / "fsi")
 work = Path(a.work).resolve()
 shutil.rmtree(work, ignore_errors=True)
 work.mkdir(parents=True)
-failures = []
+from checks import check, failures  # noqa: E402
 TOL = 1e-12
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
 
 
 def sh(cmd, timeout, **kw):

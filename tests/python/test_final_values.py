@@ -31,13 +31,7 @@ BIN = Path(a.bin).resolve()
 work = Path(a.work).resolve()
 shutil.rmtree(work, ignore_errors=True)
 work.mkdir(parents=True)
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 env = dict(os.environ, MPLBACKEND="Agg")

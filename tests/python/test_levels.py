@@ -19,13 +19,7 @@ sys.path.insert(0, str(SRC / "bench" / "fsi"))
 sys.path.insert(0, str(SRC / "python"))
 import th_stats  # noqa: E402
 
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 bin_dir = sys.argv[1] if len(sys.argv) > 1 else str(SRC / "build" / "bin")

@@ -10,13 +10,7 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[2]
 bin_dir = sys.argv[1] if len(sys.argv) > 1 else str(SRC / "build" / "bin")
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 with tempfile.TemporaryDirectory() as tmp:

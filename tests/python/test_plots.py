@@ -12,13 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from fsi import plots as P  # noqa: E402
 
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 got = P.natural_sorted(["g=100", "g=10", "g=0", "g=1", "g=1e-3", "g=-1", "dt=0.01", "dt=2e-3"])

@@ -28,13 +28,7 @@ work = Path(a.work).resolve()
 shutil.rmtree(work, ignore_errors=True)
 work.mkdir(parents=True)
 os.environ["FSI_BIN"] = str(Path(a.bin).resolve() / "fsi")
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 scene = SRC / "configs" / "sdof_model.yaml"

@@ -12,13 +12,7 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[2]
 SCRIPT = SRC / "bench" / "fsi" / "th_stats.py"
 HISTORY = SRC / "bench" / "fsi" / "reference" / "featflow_fsi3_level4_history.csv"
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 with tempfile.TemporaryDirectory() as tmp:

@@ -29,13 +29,7 @@ import numpy as np  # noqa: E402
 
 from fsi import vtk as fvtk  # noqa: E402
 
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
+from checks import check, failures  # noqa: E402
 
 
 try:
