@@ -102,8 +102,9 @@ err = fstats.relative_error_percent
 def featflow_limits(case):
     """FEATFLOW's own levels 2, 3, 4 (h halved per level) Richardson-extrapolated, per quantity
     and part: {q: {"mean"|"amplitude": {"limit", "order", "vs_level4" (%)} or None}}. None where
-    the sequence is not monotonically convergent (FSI3's, the near-zero means), so there is no
-    extrapolated value; a part equal on all three levels (the FSI2 frequencies) is its own limit."""
+    the sequence is not monotonically convergent (FSI3's) and for the near-zero means of u_y and
+    lift: there is no extrapolated value. (The frequencies, equal on FSI2's three levels, are
+    not extrapolated.)"""
     out = {}
     for q in COLUMNS:
         out[q] = {}

@@ -275,7 +275,8 @@ TEST(FluidInitialState, AnotherMeshAndElementStartFromACheckpoint) {
 // remeshing the run stops there; with it the step-start mesh is remeshed and the step solved
 // again (remesh_retries), and the run goes on to the end.
 std::pair<int, std::string> push_to_wall(const std::string& element, const std::string& remesh, int steps,
-                                         std::map<std::string, double>* timings = nullptr) {
+                                         std::map<std::string, double>* timings = nullptr,
+                                         std::map<std::string, double>* last = nullptr) {
   Case c;
   c.element = element;
   c.remesh = remesh;
@@ -289,6 +290,7 @@ std::pair<int, std::string> push_to_wall(const std::string& element, const std::
       const auto p = m.model.accept_step(fsi::StepInfo{step * kDt, kDt, step, 2});
       std::printf("%s %s step %d: scaled Jacobian %.3g\n", element.c_str(), remesh.c_str(), step,
                   p.at("mesh_min_scaled_jacobian"));
+      if (last) *last = p;
     } catch (const fsi::SolverError& e) {
       return {step, e.what()};
     }
@@ -303,11 +305,22 @@ TEST_P(FluidRemesh, AStepThatFoldsTheMeshIsRemeshedAndSolvedAgain) {
   std::printf("without remeshing: step %d: %s\n", fold, why.c_str());
   ASSERT_GT(fold, 1) << "the first step must not fold";
   EXPECT_NE(why.find("the mesh motion tangled the mesh"), std::string::npos) << why;
-  std::map<std::string, double> t;
-  const auto [stop, error] = push_to_wall(GetParam(), "", steps, &t);
+  std::map<std::string, double> t, retried, before;
+  const auto [stop, error] = push_to_wall(GetParam(), "", steps, &t, &retried);
   EXPECT_EQ(stop, 0) << error;
-  EXPECT_GE(t["remesh_retries"], 1) << "remeshes " << t["remeshes"];
+  EXPECT_EQ(t["remesh_retries"], 1) << "remeshes " << t["remeshes"];
+  EXPECT_EQ(t["remeshes"], 1);
   std::printf("with remeshing: %g remeshes, %g of them retries\n", t["remeshes"], t["remesh_retries"]);
+  // The retry is exactly a remesh of the step-start mesh: the same as remeshing after the step
+  // before the fold (a forced remesh after step fold - 1), bit for bit.
+  std::map<std::string, double> t2;
+  const auto [stop2, error2] =
+      push_to_wall(GetParam(), "{at_steps: [" + std::to_string(fold - 1) + "]}", steps, &t2, &before);
+  EXPECT_EQ(stop2, 0) << error2;
+  EXPECT_EQ(t2.count("remesh_retries"), 0u);
+  for (const char* probe : {"cyl_cd", "cyl_cl", "dp"})
+    EXPECT_EQ(fluid_test::bits(retried.at(probe)), fluid_test::bits(before.at(probe)))
+        << probe << ": " << retried.at(probe) << " vs " << before.at(probe);
 }
 
 INSTANTIATE_TEST_SUITE_P(Elements, FluidRemesh, ::testing::Values(std::string("p1p1"), std::string("p2p1")));

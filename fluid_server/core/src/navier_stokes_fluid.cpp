@@ -722,7 +722,11 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
       if (!remesh_.enabled || !motion_ || retried_step_ == info.step) throw;
       fsi::logger("fluid")->warn("fluid: {}; remeshing the step-start mesh and solving again", where(e));
       retried_step_ = info.step;
-      remesh(info, "the step's mesh motion inverted an element");
+      try {
+        remesh(info, "the step's mesh motion inverted an element");
+      } catch (const std::exception& r) {  // the fold stays the error, with why the cure failed
+        throw SolverError(fmt::format("{}; remeshing the step-start mesh failed: {}", e.what(), r.what()));
+      }
       ++remesh_retries_;
       solve_on_mesh(info, interface_displacement, interface_velocity);
     }

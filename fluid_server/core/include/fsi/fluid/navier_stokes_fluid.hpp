@@ -143,8 +143,8 @@ class NavierStokesFluid : public FluidModel {
   int factorisations_ = 0;                           // cumulative
   Eigen::VectorXd last_interface_displacement_;      // of the last solve (for the mesh motion's accept)
   Eigen::VectorXd accepted_interface_displacement_;  // of the last accepted step (a remesh's new offset)
-  int retried_step_ = -1;
-  int remesh_retries_ = 0;  // the step whose tangled motion was remeshed and retried
+  int retried_step_ = -1;                            // the step whose folding motion was remeshed and solved again
+  int remesh_retries_ = 0;                           // how many steps were (a count, also in checkpoints)
   void solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                      const Eigen::VectorXd& interface_velocity);
 };
