@@ -13,6 +13,7 @@
 
 #include "fsi/common/history_stats.hpp"
 #include "fsi/common/log.hpp"
+#include "fsi/common/write_check.hpp"
 
 namespace fs = std::filesystem;
 
@@ -71,13 +72,7 @@ void report_final_values(const fs::path& out) {
     if (!j.is_object()) return;
     if (j.contains("statistics") && j["statistics"] == stats) return;  // e.g. a command that ran nothing
     j["statistics"] = std::move(stats);
-    const fs::path tmp = summary.string() + ".tmp";
-    {
-      std::ofstream f(tmp);
-      f << j.dump(2) << '\n';
-      if (!f) throw std::runtime_error("cannot write " + tmp.string());
-    }
-    fs::rename(tmp, summary);
+    write_file_atomic(summary, j.dump(2) + "\n");  // no .tmp left on a full disk
   } catch (const std::exception& e) {
     logger("fsi")->warn("final values of {}: {}", out.string(), e.what());
   }

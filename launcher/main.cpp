@@ -39,6 +39,7 @@
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/version.hpp"
+#include "fsi/common/write_check.hpp"
 #include "fsi/coupling/checkpoint.hpp"
 #include "fsi/coupling/settings.hpp"
 #include "fsi/models/fluid_factory.hpp"
@@ -205,13 +206,9 @@ nlohmann::json read_json(const fs::path& file) {
   }
 }
 
+// Throws fsi::WriteError naming the file (a full disk); no .tmp is left behind.
 void write_json_atomic(const fs::path& file, const nlohmann::json& j) {
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << '\n';
-  }
-  fs::rename(tmp, file);
+  fsi::write_file_atomic(file, j.dump(2) + "\n");
 }
 
 // Makes summary.json final when its writer could not: status, reason, and steps equal to
@@ -228,7 +225,11 @@ void finalize_summary(const fs::path& out, const fsi::Scene& scene, const std::s
   j["status"] = status;
   j["reason"] = reason;
   j["steps"] = fsi::csv_rows(out / "probes.csv");
-  write_json_atomic(out / "summary.json", j);
+  try {
+    write_json_atomic(out / "summary.json", j);
+  } catch (const std::exception& e) {  // a full disk: the status goes to stderr instead
+    fsi::logger("fsi")->error("{}; the run's status is not in it: {}: {}", e.what(), status, reason);
+  }
 }
 
 // The newest complete checkpoint's manifest (null if none), as the coupler finds it.
@@ -325,6 +326,10 @@ void prepare_fork(const std::string& from, const fs::path& out) {
 
 // The launcher's last word on a run: its exit code, and the status and reason it writes into
 // summary.json (empty: the run's own summary stands).
+// The coupler's (and a standalone run's) exit code when an output file could not be written
+// (a full disk): EX_IOERR of sysexits.h, passed on by fsi run.
+constexpr int kExitWriteFailed = 74;
+
 struct Ending {
   int code = 1;
   std::string status, reason;
@@ -514,8 +519,12 @@ void say_how_to_resume(const RunOptions& o, const fs::path& out) {
   const auto quote = [](const std::string& a) {
     return a.find_first_of(" '\"$\\") == std::string::npos ? a : "'" + a + "'";
   };
-  fsi::logger("fsi")->info("continue it with: {} run {} --out {} --resume",
-                           quote(fs::read_symlink("/proc/self/exe").string()), quote(o.scene_path), quote(o.out_dir));
+  std::string commands;
+  if (!o.solid_command.empty()) commands += " --solid-command " + quote(o.solid_command);
+  if (!o.fluid_command.empty()) commands += " --fluid-command " + quote(o.fluid_command);
+  fsi::logger("fsi")->info("continue it with: {} run {} --out {} --resume{}",
+                           quote(fs::read_symlink("/proc/self/exe").string()), quote(o.scene_path), quote(o.out_dir),
+                           commands);
 }
 
 // Coupled: two servers and the coupler; with --recover, a server that dies or stops
@@ -543,12 +552,43 @@ int run_coupled(const RunOptions& o, const fsi::Scene& scene, const std::vector<
   stop_all({&p.coupler, &p.children[0], &p.children[1]},
            e.code == 0 || e.code == 2 || e.code == 130 ? std::chrono::seconds(3) : std::chrono::seconds(1));
   fs::remove_all(ports);
-  if (e.status.empty() && e.code != 0 && e.code != 1 && e.code != 2 && e.code != 130)
+  if (e.status.empty() && e.code == kExitWriteFailed)
+    e.reason = "the coupler could not write its output (a full disk or an I/O error; its message names the file)";
+  else if (e.status.empty() && e.code != 0 && e.code != 1 && e.code != 2 && e.code != 130)
     e = {1, "failed", fmt::format("the coupler exited with code {}", e.code)};
   finalize_summary(out, scene, e.status.empty() ? "failed" : e.status,
                    e.reason.empty() ? "the coupler ended without a final summary" : e.reason, e.status.empty());
   if (e.code != 0 && e.code != 2) say_how_to_resume(o, out);
   return e.code;
+}
+
+// The external solver commands (--solid-command, --fluid-command) a run was started with,
+// kept in OUT/commands.json so that --resume starts the same processes.
+const char* const kCommandsFile = "commands.json";
+
+void remember_commands(const RunOptions& o) {
+  write_json_atomic(fs::path(o.out_dir) / kCommandsFile,
+                    {{"solid_command", o.solid_command}, {"fluid_command", o.fluid_command}});
+}
+
+// --resume: a command not given is taken from the run folder; one given that differs from the
+// folder's is used, and the difference said.
+void recall_commands(RunOptions& o, const RunOptions& given) {
+  const auto stored = read_json(fs::path(o.out_dir) / kCommandsFile);
+  if (!stored.is_object()) return;  // a folder of an older build: the commands as given
+  auto log = fsi::logger("fsi");
+  for (auto [option, key, value, was] :
+       {std::tuple{"--solid-command", "solid_command", &o.solid_command, given.solid_command},
+        std::tuple{"--fluid-command", "fluid_command", &o.fluid_command, given.fluid_command}}) {
+    const std::string before = stored.value(key, std::string());
+    if (was.empty() && !before.empty()) {
+      *value = before;
+      log->info("{} \"{}\" (as the run was started)", option, before);
+    } else if (!was.empty() && was != before) {
+      log->warn("{} \"{}\" differs from the one the run was started with ({}); using the one given", option, was,
+                before.empty() ? std::string("the built-in server") : "\"" + before + "\"");
+    }
+  }
 }
 
 // --resume, checked before anything in --out is touched (a refused resume changes nothing):
@@ -562,9 +602,10 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
   const auto refuse = [&](const std::string& why) {
     throw fsi::ConfigError(fmt::format("--resume '{}': {}; nothing in the folder was changed", o.out_dir, why));
   };
-  if (!fs::exists(out / "summary.json")) refuse("not a run folder (no summary.json)");
   std::vector<std::string> skipped;
   const auto ckpt = fsi::coupling::CheckpointStore(out / "checkpoints", 1).newest(&skipped);
+  // A run killed as a whole before its first summary.json: its complete checkpoints prove it.
+  if (!fs::exists(out / "summary.json") && !ckpt) refuse("not a run folder (no summary.json, no checkpoint)");
   if (!ckpt)
     refuse(fs::is_directory(out / "checkpoints")
                ? "no complete checkpoint in " + (out / "checkpoints").string() +
@@ -628,6 +669,7 @@ int run(const RunOptions& given) {
     const auto overrides = prepare_resume(given);
     if (!overrides) return 0;
     o.overrides = *overrides;
+    recall_commands(o, given);
   }
   // --initial-state DIR: the fluid starts from the fields of DIR's checkpoint (fluid.initial_state).
   if (!o.initial_state.empty())
@@ -652,6 +694,15 @@ int run(const RunOptions& given) {
   if (!o.from.empty()) {
     if (!coupled) throw fsi::ConfigError("--from: only coupled runs have checkpoints to start from");
     prepare_fork(o.from, out);
+  }
+  if (coupled) {
+    // From the start the folder is a run folder: summary.json (running) until the coupler's
+    // first, and the commands a --resume starts again.
+    if (!fs::exists(out / "summary.json")) {
+      fsi::RunReport report(out, scene, "fsi");
+      report.write();
+    }
+    remember_commands(o);
   }
   std::vector<std::string> sets;
   for (const auto& ov : o.overrides) sets.insert(sets.end(), {"--set", ov});
@@ -872,6 +923,6 @@ int main(int argc, char** argv) {
     return run(o);
   } catch (const std::exception& e) {
     fsi::logger("fsi")->error("{}", e.what());
-    return 1;
+    return fsi::is_write_failure(e.what()) ? kExitWriteFailed : 1;
   }
 }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <fstream>
 
+#include "fsi/common/write_check.hpp"
+
 namespace fsi {
 namespace {
 
@@ -62,7 +64,8 @@ void prepare_output_dir(const std::filesystem::path& out_dir, OutputMode mode) {
       const std::string name = e.path().filename().string();
       const bool ours = name == "summary.json" || name == "summary.json.tmp" || name == "probes.csv" ||
                         name == "iterations.csv" || name == "vtk" || name == "checkpoints" || name == ".ports" ||
-                        name == "solid_server.log" || name == "fluid_server.log" || name == "coupler.log";
+                        name == "solid_server.log" || name == "fluid_server.log" || name == "coupler.log" ||
+                        name == "commands.json";
       if (ours) fs::remove_all(e.path());
     }
   }
@@ -95,14 +98,7 @@ void RunReport::set_status(const std::string& status, const std::string& reason)
   data_["reason"] = reason;
 }
 
-void RunReport::write() const {
-  const auto tmp = out_dir_ / "summary.json.tmp";
-  {
-    std::ofstream out(tmp);
-    out << data_.dump(2) << '\n';
-  }
-  std::filesystem::rename(tmp, out_dir_ / "summary.json");
-}
+void RunReport::write() const { write_file_atomic(out_dir_ / "summary.json", data_.dump(2) + "\n"); }
 
 ProbeTable ProbeTable::resume(std::filesystem::path path, std::size_t keep_rows) {
   ProbeTable t(path);

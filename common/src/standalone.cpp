@@ -12,6 +12,7 @@
 #include "fsi/common/log_file.hpp"
 #include "fsi/common/run_report.hpp"
 #include "fsi/common/scene_reader.hpp"
+#include "fsi/common/write_check.hpp"
 
 namespace fsi {
 namespace {
@@ -36,6 +37,7 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
   const double start = now_seconds();
   int steps_done = 0;
   long iterations = 0;                 // the solver's nonlinear iterations (Newton / fluid solves), all steps
+  bool write_failed = false;           // an output file could not be written (a full disk): exit 74
   std::map<std::string, double> last;  // the last step's probes, named as in probes.csv
   std::signal(SIGINT, on_standalone_signal);
   std::signal(SIGTERM, on_standalone_signal);
@@ -94,17 +96,23 @@ int run_loop(std::unique_ptr<Model>& model, const Scene& scene, const std::files
     report.set_status("diverged", fmt::format("{} solver failed at step {}: {}", section, steps_done + 1, e.what()));
   } catch (const std::exception& e) {
     report.set_status("failed", e.what());
+    write_failed = is_write_failure(e.what());
   }
   report.data()["steps"] = steps_done;
   report.data()["solver_iterations"] = iterations;
   if (!last.empty()) report.data()["final"] = last;  // the last row of probes.csv
   report.data()["wall_time"] = {{"total", now_seconds() - start}, {section, compute_time}};
   if (model && !model->timings().empty()) report.data()[std::string(section) + "_breakdown"] = model->timings();
-  report.write();
+  try {
+    report.write();
+  } catch (const std::exception& e) {  // a full disk: the status goes to stderr instead
+    log->error("{}; the run's status is not in it", e.what());
+    write_failed = true;
+  }
   const std::string status = report.data()["status"];
-  if (status != "completed") {
+  if (status != "completed" || write_failed) {
     log->error("{}: {}", status, report.data()["reason"].get<std::string>());
-    return status == "diverged" ? 2 : status == "interrupted" ? 130 : 1;
+    return write_failed ? 74 : status == "diverged" ? 2 : status == "interrupted" ? 130 : 1;
   }
   log->info("completed {} steps in {:.2f} s; results in {}", steps_done, now_seconds() - start, out_dir.string());
   return 0;

@@ -2,16 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
+
+#include "fsi/common/write_check.hpp"
 
 namespace fsi {
 
 CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns)
     : out_(path), columns_(columns.size()), path_(path), header_(columns) {
-  if (!out_) throw std::runtime_error("cannot write '" + path.string() + "'");
+  if (!out_) throw WriteError(path, errno ? errno : EIO);
   row(columns);
 }
 
@@ -40,8 +44,9 @@ CsvWriter CsvWriter::resume(const std::filesystem::path& path, std::size_t keep_
   std::filesystem::resize_file(path, static_cast<std::uintmax_t>(keep_bytes));
   CsvWriter w;
   w.out_.open(path, std::ios::app);
-  if (!w.out_) throw std::runtime_error("cannot write '" + path.string() + "'");
+  if (!w.out_) throw WriteError(path, errno ? errno : EIO);
   w.columns_ = header.size();
+  w.written_ = static_cast<std::uintmax_t>(keep_bytes);
   w.path_ = path;
   w.header_ = header;
   return w;
@@ -51,9 +56,21 @@ void CsvWriter::row(const std::vector<std::string>& values) {
   if (values.size() != columns_)
     throw std::invalid_argument(
         fmt::format("{}: row has {} values, header has {}", path_.string(), values.size(), columns_));
-  for (std::size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
-  out_ << '\n';
-  out_.flush();
+  std::string line;
+  for (std::size_t i = 0; i < values.size(); ++i) (line += (i ? "," : "")) += values[i];
+  line += '\n';
+  errno = 0;
+  out_ << line;
+  try {
+    check_written(out_, path_);
+  } catch (const WriteError&) {
+    // Keep the rows written before whole: cut a row that reached the disk in part.
+    out_.close();
+    std::error_code ignored;
+    std::filesystem::resize_file(path_, written_, ignored);
+    throw;
+  }
+  written_ += line.size();
 }
 
 void CsvWriter::row(const std::vector<double>& values) {

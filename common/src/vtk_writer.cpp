@@ -3,12 +3,16 @@
 #include <fmt/format.h>
 #include <zlib.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <regex>
 #include <stdexcept>
+#include <system_error>
+
+#include "fsi/common/write_check.hpp"
 
 namespace fsi {
 namespace {
@@ -178,12 +182,20 @@ void write_vtu(const std::filesystem::path& path, const VtkGrid& grid, VtkFormat
   if (grid.cells.size() != grid.cell_types.size())
     throw std::invalid_argument("write_vtu: cells and cell_types differ in size");
   std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
-  if (format == VtkFormat::Ascii)
-    write_ascii(out, grid);
-  else
-    write_binary(out, grid);
-  if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
+  if (!out) throw WriteError(path, errno ? errno : EIO);
+  errno = 0;
+  try {
+    if (format == VtkFormat::Ascii)
+      write_ascii(out, grid);
+    else
+      write_binary(out, grid);
+    check_written(out, path);
+  } catch (const WriteError&) {
+    out.close();
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);  // no half file beside the series
+    throw;
+  }
 }
 
 Eigen::MatrixXd plane_stress_tensor(const Eigen::MatrixX3d& s) {
@@ -219,15 +231,11 @@ std::filesystem::path PvdSeries::write(double time, int step, const VtkGrid& gri
   write_vtu(dir_ / file, grid, format_);
   std::erase_if(entries_, [&](const Entry& e) { return e.step >= step; });
   entries_.push_back({time, step, file});
-  const auto path = dir_ / (name_ + ".pvd");
-  {
-    std::ofstream pvd(path.string() + ".tmp");
-    pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-    for (const auto& e : entries_)
-      pvd << fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
-    pvd << "</Collection>\n</VTKFile>\n";
-  }
-  std::filesystem::rename(path.string() + ".tmp", path);
+  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  for (const auto& e : entries_)
+    pvd += fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", e.time, e.file);
+  pvd += "</Collection>\n</VTKFile>\n";
+  write_file_atomic(dir_ / (name_ + ".pvd"), pvd);
   return dir_ / file;
 }
 

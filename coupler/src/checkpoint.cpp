@@ -10,17 +10,20 @@
 #include <fstream>
 #include <regex>
 #include <stdexcept>
+#include <system_error>
 
 #include "fsi/common/state.hpp"
+#include "fsi/common/write_check.hpp"
 
 namespace fs = std::filesystem;
 
 namespace fsi::coupling {
 namespace {
 
+// Throws WriteError naming `path` (a full disk: "no space left on device").
 void write_synced(const fs::path& path, const std::string& bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw std::runtime_error(fmt::format("cannot write '{}': {}", path.string(), std::strerror(errno)));
+  if (fd < 0) throw WriteError(path, errno);
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -28,12 +31,20 @@ void write_synced(const fs::path& path, const std::string& bytes) {
       if (errno == EINTR) continue;
       const int err = errno;
       ::close(fd);
-      throw std::runtime_error(fmt::format("cannot write '{}': {}", path.string(), std::strerror(err)));
+      throw WriteError(path, err);
     }
     done += static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0)
-    throw std::runtime_error(fmt::format("cannot sync '{}': {}", path.string(), std::strerror(errno)));
+  if (injected_write_failure(path)) {
+    ::close(fd);
+    throw WriteError(path, ENOSPC);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw WriteError(path, err);
+  }
+  if (::close(fd) != 0) throw WriteError(path, errno);
 }
 
 void sync_dir(const fs::path& dir) {
@@ -107,15 +118,21 @@ CheckpointStore::Written CheckpointStore::write(int step, double time, nlohmann:
   manifest["format_version"] = kFormatVersion;
   manifest["step"] = step;
   manifest["time"] = time;
-  for (const auto& [name, bytes] : parts) {
-    const std::string file = name + ".state";
-    write_synced(tmp / file, bytes);
-    manifest["parts"][name] = {{"file", file}, {"bytes", bytes.size()}, {"crc32", crc32_hex(bytes)}};
-    written.bytes += bytes.size();
+  try {
+    for (const auto& [name, bytes] : parts) {
+      const std::string file = name + ".state";
+      write_synced(tmp / file, bytes);
+      manifest["parts"][name] = {{"file", file}, {"bytes", bytes.size()}, {"crc32", crc32_hex(bytes)}};
+      written.bytes += bytes.size();
+    }
+    const std::string text = manifest.dump(2) + "\n";
+    write_synced(tmp / "manifest.json", text);
+    written.bytes += text.size();
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(tmp, ignored);  // an incomplete checkpoint is not left behind (nor its space taken)
+    throw;
   }
-  const std::string text = manifest.dump(2) + "\n";
-  write_synced(tmp / "manifest.json", text);
-  written.bytes += text.size();
   sync_dir(tmp);
   fs::remove_all(final_dir);
   fs::rename(tmp, final_dir);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <fstream>
 #include <future>
 #include <limits>
@@ -15,6 +16,7 @@
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/state.hpp"
 #include "fsi/common/table_writer.hpp"
+#include "fsi/common/write_check.hpp"
 #include "fsi/coupling/acceleration.hpp"
 #include "fsi/coupling/checkpoint.hpp"
 #include "fsi/coupling/interface_output.hpp"
@@ -41,6 +43,32 @@ bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
 // A run-time stop with its classification.
 struct Stop {
   std::string status, reason;
+};
+
+// coupling.growth: the largest interface displacement |d|_inf of the last `window` accepted
+// steps against that of the `window` steps before; more than `factor` times = unbounded growth
+// (a loosely coupled scheme above its stability limit), the run diverged. Watched from step
+// 2 x window of this segment on (a resumed run starts watching again).
+class GrowthWatch {
+ public:
+  void add(double value, int step, double factor, int window) {
+    const auto w = static_cast<std::size_t>(window);
+    history_.push_back(value);
+    if (history_.size() > 2 * w) history_.pop_front();
+    if (history_.size() < 2 * w) return;
+    const double before = *std::max_element(history_.begin(), history_.begin() + static_cast<std::ptrdiff_t>(w));
+    const double last = *std::max_element(history_.begin() + static_cast<std::ptrdiff_t>(w), history_.end());
+    if (before > 0 && last > factor * before)  // growth from exactly 0 (a load that starts late) is not measured
+      throw Stop{"diverged",
+                 fmt::format("unbounded growth: the interface displacement grew {:.3g}-fold in {} steps (largest "
+                             "|d| {:.3e} in steps {}-{}, {:.3e} in steps {}-{}; coupling.growth.factor {:g}): a "
+                             "loosely coupled scheme above its stability limit?",
+                             last / before, window, before, step - 2 * window + 1, step - window, last,
+                             step - window + 1, step, factor)};
+  }
+
+ private:
+  std::deque<double> history_;
 };
 
 }  // namespace
@@ -221,6 +249,7 @@ struct Coupler::Run {
   std::optional<ProbeTable> probes;
   CsvWriter iterations, timing;
   std::optional<Progress> progress;
+  GrowthWatch growth;
 };
 
 RunOutcome Coupler::run(RunReport& report) {
@@ -273,6 +302,7 @@ RunOutcome Coupler::run(RunReport& report) {
   } catch (const std::exception& e) {
     out.status = "failed";
     out.reason = fmt::format("{}: {}", at(), e.what());
+    out.write_failed = is_write_failure(e.what());
   }
   times_.total = now() - start;
   return out;
@@ -1045,6 +1075,7 @@ void Coupler::accept_step(Run& r, Step& step) {
   for (const auto& [name, v] : row)
     if (!std::isfinite(v)) throw Stop{"diverged", fmt::format("probe '{}' is not finite at step {}", name, n)};
   r.probes->add(t_np1, row);
+  r.out.steps = n;  // the step is in probes.csv: a later failure (its output) reports it done
   // before the checkpoint of this step, so a checkpoint never has fewer timing rows than steps
   r.timing.row(std::vector<double>{double(n), t_np1, r.wall_before + (now() - r.segment_start), times_.fluid,
                                    times_.solid, double(used)});
@@ -1056,8 +1087,10 @@ void Coupler::accept_step(Run& r, Step& step) {
                                  last.loads.velocity_integral});
   r.accelerator->end_step();
   r.state.accept_force(step.force);
-  r.out.steps = n;
-  if (r.checkpoints && n % r.time.checkpoint_every == 0 && n < r.time.steps) {
+  r.growth.add(last.s.interface_displacement.lpNorm<Eigen::Infinity>(), n, settings_.growth_factor,
+               settings_.growth_window);
+  // ... and at the final step, so that extending the run (--resume --set time.end) recomputes nothing
+  if (r.checkpoints && (n % r.time.checkpoint_every == 0 || n == r.time.steps)) {
     save_checkpoint(r, n, t_np1);
     r.data["checkpoints"]["seconds"] = times_.checkpoint;
   }

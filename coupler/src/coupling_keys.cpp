@@ -147,6 +147,14 @@ schema::Key declare_coupling() {
               .in_unit("m")
               .only_when("mapping", {"rbf-wendland-c2"}, "nearest-segment"),
           number("force_limit", "an interface force above this = diverged").def("1e12").gt(0).in_unit("N"),
+          section("growth",
+                  "unbounded growth = diverged: the largest interface displacement |d| of the last `window` "
+                  "steps more than `factor` times that of the `window` steps before (a loosely coupled scheme "
+                  "above its stability limit); watched from step 2 x window on",
+                  {
+                      number("factor", "growth over one window that ends the run as diverged").def("1000").gt(1),
+                      integer("window", "steps per window").def("200").ge(1).in_unit("steps"),
+                  }),
 
       });
   coupling.check = [](const Scene& scene) { (void)read_coupling(scene.section("coupling")); };

@@ -223,13 +223,23 @@ int write_summary(const Options& o, fsi::RunReport& report, const Servers& serve
                                   {"wall_seconds", report.data().value("wall_time_earlier_segments", 0.0) + elapsed}};
     if (o.recoverable) {
       report.set_status("failed", outcome.reason + " (the launcher will try to recover)");
-      report.write();
+      try {
+        report.write();
+      } catch (const std::exception& e) {
+        log->error("{}", e.what());
+        return fsi::coupling::RunOutcome::kExitWriteFailed;
+      }
       log->error("{}: {}", lost, outcome.reason);
       return 75;
     }
   }
   report.set_status(outcome.status, outcome.reason);
-  report.write();
+  try {
+    report.write();
+  } catch (const std::exception& e) {  // a full disk: the status goes to stderr instead
+    log->error("{}; the run's status is not in it: {}: {}", e.what(), outcome.status, outcome.reason);
+    return -2;
+  }
   return -1;
 }
 
@@ -270,7 +280,9 @@ int main(int argc, char** argv) {
 
   // 3. Connect (handshake), run, write the summary, stop the servers.
   run_coupled(o, *scene, report, servers, outcome, start, log);
-  if (const int code = write_summary(o, report, servers, outcome, start, log); code >= 0) return code;
+  const int code = write_summary(o, report, servers, outcome, start, log);
+  if (code >= 0) return code;
+  if (code == -2) outcome.write_failed = true;
   stop_servers(servers, outcome.status, log);
   if (outcome.status == "completed")
     log->info("completed {} steps, {} coupling iterations; results in {}", outcome.steps, outcome.iterations,

@@ -148,6 +148,8 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   c.robin_mass = s.get<std::string>("robin_mass") == "solid" ? RobinMass::Solid : RobinMass::Consistent;
   read_mapping(s, c);
   c.force_limit = s.get<double>("force_limit");
+  c.growth_factor = s.child_or_defaults("growth").get<double>("factor");
+  c.growth_window = s.child_or_defaults("growth").get<int>("window");
   return c;
 }
 

@@ -8,6 +8,7 @@ The runs are the SDOF model problem (configs/sdof_model.yaml: 500 steps, well un
 """
 import argparse
 import hashlib
+import json
 import os
 import subprocess
 import sys
@@ -87,13 +88,20 @@ def extend(tmp):
     checkpoint); the tables equal those of one run to T2."""
     short, whole = os.path.join(tmp, "short"), os.path.join(tmp, "whole")
     sets = ["--set", "time.checkpoint_every=50", "--set", "coupling.relaxation=0.7", "--set", "coupling.iterations.max=3"]
-    run_ok(SCENE, "--out", short, *sets, "--set", "time.end=4")
+    # t = 4.5: 225 steps, the last not on the checkpoint schedule (every 50): the final step's
+    # checkpoint lets the extension continue from step 225 without computing a step again.
+    run_ok(SCENE, "--out", short, *sets, "--set", "time.end=4.5")
+    assert os.path.isdir(os.path.join(short, "checkpoints", "step_00000225")), os.listdir(os.path.join(short, "checkpoints"))
     run_ok(SCENE, "--out", short, "--resume", "--set", "time.end=6")
+    with open(os.path.join(short, "summary.json")) as f:
+        resumed = json.load(f)["resumed_from_step"]
+    assert resumed == 225, f"the extension resumed from step {resumed}, not from the final step 225"
     run_ok(SCENE, "--out", whole, *sets, "--set", "time.end=6")
     for name in ("probes.csv", "iterations.csv"):
         with open(os.path.join(short, name), "rb") as a, open(os.path.join(whole, name), "rb") as b:
             assert a.read() == b.read(), f"{name}: the extended run differs from the run to t = 6"
-    print("extended 4 -> 6: probes.csv and iterations.csv byte-identical to one run to 6")
+    print("extended 4.5 -> 6 from the final step's checkpoint (step 225, none recomputed): probes.csv and "
+          "iterations.csv byte-identical to one run to 6")
 
 
 def study_invalid_case(tmp):

@@ -224,6 +224,89 @@ def resume_fsi3(env):
     resume_case(env, "fsi3_iqn", "SIGINT")
 
 
+def resume_external(env):
+    """A run with an external solid (--solid-command) is resumed with `--resume` alone: the
+    command is remembered in the run folder (the printed continue line names it too); a
+    different command given with --resume is used and the difference said."""
+    solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
+    scene, sets, kill_at, limit = RESUME_CASES["sdof_model"]
+    ref, out = env.out("external_ref"), env.out("external_cut")
+    code, log = finish(launch(env, scene, ref, sets, ("--solid-command", solid)), limit)
+    assert code == 0, log[-2000:]
+    p = launch(env, scene, out, sets, ("--solid-command", solid))
+    wait_rows(os.path.join(out, "probes.csv"), kill_at, p, limit)
+    process_named(out, "coupler").kill()
+    code, log = finish(p, 15)
+    assert_final(out, "failed", 1, code)
+    assert f"--resume --solid-command '{solid}'" in log, log[-1500:]
+    assert_no_leftovers(out)
+    code, log = finish(launch(env, scene, out, [], ("--resume",)), limit)
+    assert code == 0, log[-3000:]
+    assert f'--solid-command "{solid}" (as the run was started)' in log, log[-3000:]
+    s = assert_final(out, "completed")
+    assert_identical(ref, out)
+    print(f"external solid: killed at step {kill_at}, `--resume` alone resumed from step {s['resumed_from_step']} "
+          f"with the remembered --solid-command; tables byte-identical to the uninterrupted run")
+    # Another command than the run's: used, and said.
+    other = env.out("other_solid.sh")
+    with open(other, "w") as f:
+        f.write(f"#!/bin/sh\nexec {solid} \"$@\"\n")
+    os.chmod(other, 0o755)
+    code, log = finish(launch(env, scene, out, ["time.end=44"], ("--resume", "--solid-command", other)), limit)
+    assert code == 0, log[-3000:]
+    assert f'--solid-command "{other}" differs from the one the run was started with ("{solid}")' in log, log[-3000:]
+    print("a different --solid-command on --resume: used, and the difference named")
+
+
+def resume_before_summary(env):
+    """A run killed as a whole (SIGKILL to the launcher and, by the parent-death signal, its
+    processes) a third of the way through: --resume continues it. Its folder holds summary.json
+    from the start; an older folder without one is proven a run folder by its checkpoints."""
+    scene = "added_mass.yaml"
+    sets = ["time.end=20", "time.checkpoint_every=100", "coupling.acceleration=aitken"]
+    ref = env.out("early_ref")
+    code, log = finish(launch(env, scene, ref, sets), 120)
+    assert code == 0, log[-2000:]
+    for trial, drop_summary in ((1, False), (2, True)):
+        out = env.out(f"early_{trial}")
+        p = launch(env, scene, out, sets)
+        wait_rows(os.path.join(out, "probes.csv"), 667, p, 120)
+        os.killpg(p.pid, signal.SIGKILL)
+        p.wait(timeout=10)
+        assert_no_leftovers(out, timeout=10)
+        assert os.path.exists(os.path.join(out, "summary.json")), os.listdir(out)
+        if drop_summary:
+            os.remove(os.path.join(out, "summary.json"))  # a folder of a build that wrote it later
+        code, log = finish(launch(env, scene, out, sets, ("--resume",)), 120)
+        assert code == 0, log[-3000:]
+        s = assert_final(out, "completed")
+        assert_identical(ref, out)
+        print(f"killed as a whole at {667}+ rows{' (summary.json removed)' if drop_summary else ''}: resumed from step "
+              f"{s['resumed_from_step']}, tables byte-identical to the uninterrupted run")
+
+
+def growth(env):
+    """Unbounded growth (coupling.growth): the added-mass model, parallel and loosely coupled
+    (one iteration per step) above its stability limit (relaxation 0.11), grows from |d| 0.85 to
+    6e3 within 200 steps: diverged (exit 2), the growth named, instead of 500 steps 'completed'
+    at |d| = 2.8e5. Just below the limit (0.10) it completes; a larger factor lets it run."""
+    sets = ["coupling.scheme=parallel", "coupling.iterations.max=1", "coupling.iterations.tolerance=0", "time.end=5"]
+    out = env.out("growth_unstable")
+    code, log = env.fsi("added_mass.yaml", out, *sets, "coupling.relaxation=0.11")
+    s = assert_final(out, "diverged", 2, code)
+    assert "unbounded growth: the interface displacement grew" in s["reason"] and "coupling.growth.factor 1000" in \
+        s["reason"], s["reason"]
+    assert s["steps"] == 400, s["steps"]
+    print(f"relaxation 0.11: diverged at step {s['steps']}: {s['reason']}")
+    out = env.out("growth_stable")
+    code, log = env.fsi("added_mass.yaml", out, *sets, "coupling.relaxation=0.1")
+    s = assert_final(out, "completed", 0, code)
+    out = env.out("growth_allowed")
+    code, log = env.fsi("added_mass.yaml", out, *sets, "coupling.relaxation=0.11", "coupling.growth={factor: 1e9}")
+    s = assert_final(out, "completed", 0, code)
+    print("relaxation 0.10 completes; 0.11 with coupling.growth.factor 1e9 completes")
+
+
 def resume_refused(env):
     """--resume refuses a different scene, naming the keys; a non-empty --out is refused
     without --resume or --force."""
@@ -266,12 +349,13 @@ def fork(env):
     fork_lines = read(os.path.join(same, "probes.csv")).split(b"\n")
     assert fork_lines[0] == ref_lines[0] and fork_lines[1:] == ref_lines[101:], "forked rows differ from the original's"
     changed = env.out("fork_changed")
-    code, log = env.fsi("sdof_model.yaml", changed, *sets[:3], "coupling.gamma_n1=100", extra=("--from", ref))
+    code, log = env.fsi("sdof_model.yaml", changed, "time.end=6", *sets[1:3], "coupling.gamma_n1=100",
+                        extra=("--from", ref))
     assert code == 0, log
     s = summary(changed)
-    assert s["forked_from"]["step"] == 100, s["forked_from"]  # the newest checkpoint of the 200-step run
+    assert s["forked_from"]["step"] == 200, s["forked_from"]  # the newest checkpoint: the 200-step run's final step
     assert any(c.startswith("coupling.gamma_n1: 10 (checkpoint) vs 100 (now)") for c in s["forked_from"]["changed"]), s
-    assert rows(os.path.join(changed, "probes.csv")) == 200 - s["forked_from"]["step"], s
+    assert rows(os.path.join(changed, "probes.csv")) == 300 - s["forked_from"]["step"], s
     for n, b in before.items():
         assert read(os.path.join(ref, n)) == b, f"--from changed the original's {n}"
     # Another time step would number the steps from another t = 0: refused, naming the key.
@@ -551,7 +635,105 @@ def vtk_output(env):
     print("  fluid.output.vtk_every: 0 named in a warning")
 
 
+# ------------------------------------------------------------------------------ failed writes
+def leftovers_tmp(out):
+    return [os.path.join(d, f) for d, dirs, files in os.walk(out) for f in files + dirs if f.endswith(".tmp")]
+
+
+def complete_rows(path):
+    """The data rows of a CSV table; every row must have the header's number of fields and parse."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    assert lines[-1] == "", f"{path} ends without a newline: {lines[-1][-40:]!r}"
+    header = lines[0].split(",")
+    for line in lines[1:-1]:
+        fields = line.split(",")
+        assert len(fields) == len(header), f"{path}: a cut row {line!r}"
+        [float(x) for x in fields]
+    return len(lines) - 2
+
+
+def write_failure(env):
+    """A write that fails (FSI_TEST_WRITE_FAILURE injects a full disk at the N-th write of a file)
+    ends the run with exit 74 and 'no space left on device' naming the file, never 'completed':
+    in probes.csv (the rows before intact), in summary.json (then the status goes to stderr), in a
+    checkpoint (the one before intact, no incomplete folder), in the interface VTK. No *.tmp stays."""
+    cases = [("probes.csv:100", ["time.end=40"], "probes.csv"),
+             ("iterations.csv:50", ["time.end=40"], "iterations.csv"),
+             ("coupler.state:2", ["time.end=40", "time.checkpoint_every=100"], "coupler.state"),
+             ("interface_solid_000010.vtu", ["time.end=1", "time.output_every=5"], "interface_solid_000010.vtu"),
+             ("interface_solid.pvd:3", ["time.end=1", "time.output_every=5"], "interface_solid.pvd")]
+    for spec, sets, name in cases:
+        out = env.out("wf_" + name)
+        os.environ["FSI_TEST_WRITE_FAILURE"] = spec
+        try:
+            code, log = finish(launch(env, "sdof_model.yaml", out, sets, ("--recover", "0")), 60)
+        finally:
+            del os.environ["FSI_TEST_WRITE_FAILURE"]
+        s = assert_final(out, "failed", 74, code)
+        assert "no space left on device" in s["reason"] and name in s["reason"], s["reason"]
+        assert "completed" not in log, log[-2000:]
+        assert not leftovers_tmp(out), leftovers_tmp(out)
+        n = complete_rows(os.path.join(out, "probes.csv"))
+        complete_rows(os.path.join(out, "iterations.csv"))
+        if name == "probes.csv":
+            assert n == 98, n  # the header and 98 rows written, the 99th failed
+        if name == "coupler.state":
+            assert sorted(os.listdir(os.path.join(out, "checkpoints"))) == ["step_00000100"], \
+                os.listdir(os.path.join(out, "checkpoints"))
+            assert "continue it with" in log, log[-1500:]
+        assert_no_leftovers(out)
+        print(f"{spec}: exit 74, {n} complete rows; {s['reason']}")
+    # summary.json cannot be written at all (the disk is full from the start): the run does not
+    # start, the file is named, nothing is left half-written. (The coupler's own summary on a full
+    # disk: integration.resilience.full_disk.)
+    out = env.out("wf_summary")
+    os.environ["FSI_TEST_WRITE_FAILURE"] = "summary.json:1"
+    try:
+        code, log = finish(launch(env, "sdof_model.yaml", out, ["time.end=4"]), 60)
+    finally:
+        del os.environ["FSI_TEST_WRITE_FAILURE"]
+    assert code == 74, (code, log[-2000:])
+    assert "summary.json': no space left on device" in log, log[-2000:]
+    assert not os.path.exists(os.path.join(out, "summary.json")) and not leftovers_tmp(out), os.listdir(out)
+    print("summary.json: exit 74, named on stderr, no summary.json.tmp")
+
+
+def full_disk(env):
+    """A real full disk: a 64 KB tmpfs as --out (skipped, exit 77, where mount is not permitted).
+    The run stops with exit 74 and 'no space left on device' naming the file (in summary.json, or
+    on stderr when even that cannot be written); the tables hold complete rows only; no *.tmp."""
+    mnt = env.out("tmpfs")
+    os.makedirs(mnt)
+    p = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", mnt], capture_output=True, text=True)
+    if p.returncode != 0:
+        print(f"SKIPPED: cannot mount a tmpfs here ({p.stderr.strip() or p.returncode}); "
+              "integration.resilience.write_failure covers the same paths by an injected failure")
+        raise SystemExit(77)
+    try:
+        out = os.path.join(mnt, "run")
+        code, log = finish(launch(env, "sdof_model.yaml", out, ["time.end=40"]), 60)
+        assert code == 74, (code, log[-2000:])
+        assert "no space left on device" in log, log[-2000:]
+        files = sorted(os.listdir(out))
+        assert not leftovers_tmp(out), files
+        n = complete_rows(os.path.join(out, "probes.csv"))
+        complete_rows(os.path.join(out, "iterations.csv"))
+        if os.path.exists(os.path.join(out, "summary.json")):
+            s = summary(out)
+            status = "summary.json " + s["status"] + ": " + s["reason"]
+            assert s["status"] == "failed" and "no space left on device" in s["reason"], s
+        else:
+            status = "summary.json could not be written: " + \
+                next(line for line in log.splitlines() if "the run's status is not in it" in line)
+        assert_no_leftovers(out)
+        print(f"64 KB tmpfs: exit 74 after {n} complete rows; {status}")
+    finally:
+        subprocess.run(["umount", "-l", mnt], check=False)
+
+
 if __name__ == "__main__":
     main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_refused, fork,
                                   recover_kill, recover_kill_fenics, recover_stop, recover_gives_up, exit_paths,
-                                  coupler_death, orphan_servers, vtk_output)})
+                                  coupler_death, orphan_servers, vtk_output, write_failure, full_disk,
+                                  resume_external, resume_before_summary, growth)})

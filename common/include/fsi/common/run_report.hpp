@@ -31,7 +31,7 @@ class RunReport {
   RunReport(std::filesystem::path out_dir, const Scene& scene, std::string runner);
   nlohmann::json& data() { return data_; }
   void set_status(const std::string& status, const std::string& reason = "");
-  void write() const;  // atomic (write temp, rename)
+  void write() const;  // atomic (write temp, rename); throws WriteError naming the file
   const std::filesystem::path& out_dir() const { return out_dir_; }
 
  private:

@@ -1,6 +1,6 @@
 #pragma once
 // CSV tables written row by row and flushed after each row, so a run that dies keeps
-// every row written before.
+// every row written before; a row that cannot be written (a full disk) is an error.
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -22,13 +22,15 @@ class CsvWriter {
   bool is_open() const { return out_.is_open(); }
   const std::vector<std::string>& header() const { return header_; }
   std::size_t columns() const { return columns_; }
-  // Writes one row; throws std::invalid_argument if its size differs from the header's.
+  // Writes one row; throws std::invalid_argument if its size differs from the header's, and
+  // WriteError (the file named, the partial row cut off) if it does not reach the disk.
   void row(const std::vector<double>& values);
   void row(const std::vector<std::string>& values);
 
  private:
   std::ofstream out_;
   std::size_t columns_ = 0;
+  std::uintmax_t written_ = 0;  // bytes of the complete rows on disk
   std::filesystem::path path_;
   std::vector<std::string> header_;
 };

@@ -48,10 +48,13 @@ struct RunOutcome {
   std::string reason;
   int steps = 0;
   long iterations = 0;
-  int resumed_from = -1;  // the checkpoint's step when resumed
+  int resumed_from = -1;      // the checkpoint's step when resumed
+  bool write_failed = false;  // an output file could not be written (a full disk): exit 74
   int exit_code() const {
+    if (write_failed) return kExitWriteFailed;
     return status == "completed" ? 0 : status == "diverged" ? 2 : status == "interrupted" ? 130 : 1;
   }
+  static constexpr int kExitWriteFailed = 74;  // EX_IOERR (sysexits.h)
 };
 
 struct CouplerTimes {

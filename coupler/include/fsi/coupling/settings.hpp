@@ -103,7 +103,10 @@ struct CouplingSettings {
   bool stop_if_not_converged = true;  // with a tolerance: not converged in k_max = diverged
   double divergence_factor = 1e4;     // residual growth over the step's first residual
   double force_limit = 1e12;          // |F| above this = diverged (loosely coupled blow-up)
-  double residual_floor = 1e-14;      // absolute floor of the residual's denominator
+  // coupling.growth: max |d| of the last window steps > factor x that of the window before = diverged
+  double growth_factor = 1000;
+  int growth_window = 200;
+  double residual_floor = 1e-14;  // absolute floor of the residual's denominator
   RobinMass robin_mass = RobinMass::Consistent;
   // iterations.measures (or, without it, iterations.tolerance as {force, relative}); empty =
   // always k_max iterations (the paper).
