@@ -53,8 +53,8 @@ namespace {
 // coupler's Hello within 5 s; at the end each process gets 3 s to exit after Stop (1 s when
 // the run failed: a server that never answered got no Stop it could obey), then SIGTERM,
 // then SIGKILL 0.5 s later.
-constexpr std::chrono::seconds kPortFileWait{10};
-constexpr int kHelloWaitSeconds = 5;
+constexpr std::chrono::seconds kPortFileWait{60};
+constexpr int kHelloWaitSeconds = 30;  // generous: a loaded machine, a Python solver importing its modules
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int sig) { g_signal = sig; }

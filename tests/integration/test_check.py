@@ -56,7 +56,8 @@ def expect(args, code, stdout="", stderr="", **kw):
 
 
 def shipped():
-    """Every scene in configs/ and every study in studies/ passes, in well under a second each."""
+    """Every scene in configs/ and every study in studies/ passes (how fast: bench/fsi/check_speed.py,
+    not here: a test does not depend on the machine's speed)."""
     files = sorted(glob.glob("configs/*.yaml", root_dir=ARGS.source)) + \
         sorted(glob.glob("studies/*.yaml", root_dir=ARGS.source))
     assert len(files) > 20, files
@@ -66,7 +67,6 @@ def shipped():
         assert code == 0 and err == "" and out.startswith(f"OK: {f} (") and out.endswith(" keys checked)\n"), \
             (f, code, out, err)
         slowest = max(slowest, seconds)
-    assert slowest < 1.0, slowest
     print(f"{len(files)} files OK, slowest {slowest:.3f} s")
 
 
@@ -83,8 +83,7 @@ def solver_typos():
                                   "(did you mean 'max_iterations'?)\n"
                                   f"{place(scene, 'supg: 1.5')}: 'fluid.stabilisation.supg' must be a boolean "
                                   "(true/false), got '1.5'\n", env=env)
-        assert seconds < 1.0, seconds
-        assert os.listdir(cache) == [], os.listdir(cache)
+        assert os.listdir(cache) == [], os.listdir(cache)  # nothing meshed (the speed: bench/fsi/check_speed.py)
         # A key of the other model, and of the other element.
         expect(["check", "configs/fsi3.yaml", "--set", "solid.mass=1", "--set", "fluid.stabilisation.grad_div=1"], 1,
                "", "configs/fsi3.yaml (--set solid.mass=1): unknown key 'solid.mass' for solid.model 'fem' (it is a "
@@ -98,7 +97,7 @@ def solver_typos():
                                   "(did you mean 'max_iterations'?)\n"
                                   f"{place(scene, 'supg: 1.5')}: 'fluid.stabilisation.supg' must be a boolean "
                                   "(true/false), got '1.5'\n", env=env)
-        assert seconds < 1.0 and os.listdir(cache) == [], (seconds, os.listdir(cache))
+        assert os.listdir(cache) == [], (seconds, os.listdir(cache))
         # A refused scene writes nothing: the corrected one runs into the same --out.
         assert not os.path.exists(out), os.listdir(out)
         print(f"typos reported in {seconds:.3f} s, mesh cache empty, nothing written to --out")

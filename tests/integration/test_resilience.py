@@ -465,13 +465,36 @@ def recover_stop(env):
     recovery_trials(env, "solid", "stop", TRIALS or 1, 4)
 
 
+CRASH_AFTER_CONNECT = """#!{python}
+import os, signal, subprocess, sys, time
+args = sys.argv[1:]
+server = subprocess.Popen(["{server}", *args])
+port_file = args[args.index("--port-file") + 1]
+deadline = time.time() + 120
+port = None
+while time.time() < deadline and server.poll() is None:
+    if port is None and os.path.exists(port_file):
+        text = open(port_file).read().strip()
+        port = int(text.rsplit(":", 1)[1]) if text else None
+    if port is not None:
+        with open("/proc/net/tcp") as f:  # an ESTABLISHED (01) connection on the server's port
+            if any(int(l.split()[1].split(":")[1], 16) == port and l.split()[3] == "01" for l in list(f)[1:]):
+                break
+    time.sleep(0.02)
+time.sleep(0.2)
+server.send_signal(signal.SIGKILL)
+server.wait()
+"""
+
+
 def recover_gives_up(env):
     """A server that dies at every start: the launcher gives up after --recover N, failed."""
     out = env.out("gives_up")
     crash = env.out("crash_solid.sh")
     with open(crash, "w") as f:
-        # Serves, then dies on its own a moment after the first coupler connects.
-        f.write(f"#!/bin/sh\n{env.exe('solid_server')} \"$@\" & pid=$!\nsleep 0.6; kill -9 $pid\n")
+        # Serves, then dies on its own once the coupler is connected (a state, polled: not a
+        # fixed delay, which a loaded machine outlasts before the coupler connects).
+        f.write(CRASH_AFTER_CONNECT.format(python="/usr/bin/python3", server=env.exe("solid_server")))
     os.chmod(crash, 0o755)
     t0 = time.time()
     p = launch(env, "sdof_model.yaml", out, ["time.end=400", "time.checkpoint_every=50"],
