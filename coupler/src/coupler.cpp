@@ -301,8 +301,11 @@ RunOutcome Coupler::run(RunReport& report) {
     out.reason = fmt::format("solver failed {}: {}", at(), e.what());
   } catch (const std::exception& e) {
     out.status = "failed";
-    out.reason = fmt::format("{}: {}", at(), e.what());
     out.write_failed = is_write_failure(e.what());
+    // a write fails after the last step in probes.csv (its row, output or checkpoint, or the next row)
+    out.reason = fmt::format(
+        "{}: {}", out.write_failed && phase == Phase::Stepping ? fmt::format("after step {}", out.steps) : at(),
+        e.what());
   }
   times_.total = now() - start;
   return out;
