@@ -172,7 +172,8 @@ void add_geometric_stiffness(typename ElementTraits<Shape>::Matrix& K,
 // Natural strains (Voigt, doubled shears) -> Cartesian strains with K = J^-1, K(A, j) = dxi_A/dX_j:
 // E_ij = K(A, i) K(B, j) E_AB.
 template <int dim>
-Eigen::Matrix<double, voigt_size<dim>, voigt_size<dim>> strain_transformation(const Eigen::Matrix<double, dim, dim>& K) {
+Eigen::Matrix<double, voigt_size<dim>, voigt_size<dim>> strain_transformation(
+    const Eigen::Matrix<double, dim, dim>& K) {
   constexpr auto pairs = strain_pairs<dim>();
   Eigen::Matrix<double, voigt_size<dim>, voigt_size<dim>> T;
   for (int a = 0; a < voigt_size<dim>; ++a)
@@ -374,18 +375,16 @@ bool inverse_map(const typename ElementTraits<Shape>::Coords& X, const typename 
   return xi.allFinite();  // converged to round-off
 }
 
-#define FSI_SOLID_INSTANTIATE(Shape)                                                                                 \
-  template ElementStateT<Shape> internal_force<Shape>(const ElementTraits<Shape>::Coords&,                           \
-                                                      const ElementTraits<Shape>::Vector&,                           \
-                                                      const MaterialLaw<Shape::dim>&, bool);                         \
-  template ElementStateT<Shape> eas_internal_force<Shape>(const ElementTraits<Shape>::Coords&,                       \
-                                                          const ElementTraits<Shape>::Vector&,                       \
-                                                          const MaterialLaw<Shape::dim>&, bool);                     \
-  template ElementTraits<Shape>::Matrix element_mass<Shape>(const ElementTraits<Shape>::Coords&, double);            \
-  template ElementTraits<Shape>::Vector element_body_force<Shape>(const ElementTraits<Shape>::Coords&,               \
-                                                                  const Eigen::Matrix<double, Shape::dim, 1>&);      \
-  template ElementTraits<Shape>::Tensor deformation_gradient<Shape>(                                                 \
-      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const Shape::Point&);                \
+#define FSI_SOLID_INSTANTIATE(Shape)                                                                                   \
+  template ElementStateT<Shape> internal_force<Shape>(                                                                 \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool); \
+  template ElementStateT<Shape> eas_internal_force<Shape>(                                                             \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool); \
+  template ElementTraits<Shape>::Matrix element_mass<Shape>(const ElementTraits<Shape>::Coords&, double);              \
+  template ElementTraits<Shape>::Vector element_body_force<Shape>(const ElementTraits<Shape>::Coords&,                 \
+                                                                  const Eigen::Matrix<double, Shape::dim, 1>&);        \
+  template ElementTraits<Shape>::Tensor deformation_gradient<Shape>(                                                   \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const Shape::Point&);                  \
   template bool inverse_map<Shape>(const ElementTraits<Shape>::Coords&, const Shape::Point&, Shape::Point&);
 FSI_SOLID_INSTANTIATE(Quad4)
 FSI_SOLID_INSTANTIATE(Hex8)

@@ -169,17 +169,15 @@ std::unique_ptr<MaterialLaw<dim>> make_material(const std::string& law, ElasticC
   throw std::invalid_argument("unknown material law '" + law + "' (known: saint_venant_kirchhoff, neo_hookean)");
 }
 
-std::unique_ptr<Material> make_material(const std::string& law, ElasticConstants c) {
-  return make_material<2>(law, c);
-}
+std::unique_ptr<Material> make_material(const std::string& law, ElasticConstants c) { return make_material<2>(law, c); }
 
-#define FSI_SOLID_INSTANTIATE(dim)                                                                      \
-  template struct KinematicsT<dim>;                                                                     \
-  template class SaintVenantKirchhoffT<dim>;                                                            \
-  template class NeoHookeanT<dim>;                                                                      \
+#define FSI_SOLID_INSTANTIATE(dim)                                                                            \
+  template struct KinematicsT<dim>;                                                                           \
+  template class SaintVenantKirchhoffT<dim>;                                                                  \
+  template class NeoHookeanT<dim>;                                                                            \
   template Eigen::Matrix<double, dim, dim> from_voigt<dim>(const Eigen::Matrix<double, voigt_size<dim>, 1>&); \
-  template Eigen::Matrix<double, voigt_size<dim>, 1> cauchy_stress<dim>(                                \
-      const KinematicsT<dim>&, const Eigen::Matrix<double, voigt_size<dim>, 1>&);                       \
+  template Eigen::Matrix<double, voigt_size<dim>, 1> cauchy_stress<dim>(                                      \
+      const KinematicsT<dim>&, const Eigen::Matrix<double, voigt_size<dim>, 1>&);                             \
   template std::unique_ptr<MaterialLaw<dim>> make_material<dim>(const std::string&, ElasticConstants);
 FSI_SOLID_INSTANTIATE(2)
 FSI_SOLID_INSTANTIATE(3)

@@ -264,7 +264,7 @@ ElementStateT<Shape> SolidSystem::cell_state(int c, const Eigen::VectorXd& d, bo
   }();
   if (is_enhanced(element_))
     return eas_internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
-  return internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
+  return solid::internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
 }
 
 Eigen::VectorXd SolidSystem::internal_force(const Eigen::VectorXd& d) const {

@@ -24,7 +24,7 @@ struct Quad4 {
   using Point = Eigen::Vector2d;
   static Eigen::Matrix<double, 4, 1> shape(const Point& xi);
   static Eigen::Matrix<double, 4, 2> derivatives(const Point& xi);  // dN/dxi
-  static const std::array<std::pair<Point, double>, 4>& gauss();     // 2x2, xi outer
+  static const std::array<std::pair<Point, double>, 4>& gauss();    // 2x2, xi outer
   // Andelfinger & Ramm (1993) Q1E4: E_xixi ~ xi, E_etaeta ~ eta, 2 E_xieta ~ [xi, eta].
   static Eigen::Matrix<double, 3, 4> enhanced_modes(const Point& xi);
 };
@@ -51,9 +51,9 @@ struct ElementTraits {
 template <class Shape>
 struct ElementStateT {
   typename ElementTraits<Shape>::Vector internal_force = ElementTraits<Shape>::Vector::Zero();  // int B^T S dV
-  typename ElementTraits<Shape>::Matrix tangent = ElementTraits<Shape>::Matrix::Zero();  // material + geometric
-  double min_det_F = 1;         // over the Gauss points
-  double min_det_jacobian = 1;  // of the reference map
+  typename ElementTraits<Shape>::Matrix tangent = ElementTraits<Shape>::Matrix::Zero();         // material + geometric
+  double min_det_F = 1;                                                                         // over the Gauss points
+  double min_det_jacobian = 1;                                                                  // of the reference map
 };
 
 // Internal force and consistent tangent for displacement u. When `with_tangent` is false
@@ -101,9 +101,7 @@ using ElementMatrix = ElementTraits<Quad4>::Matrix;
 using ElementState = ElementStateT<Quad4>;
 
 inline Eigen::Vector4d q4_shape(double xi, double eta) { return Quad4::shape({xi, eta}); }
-inline Eigen::Matrix<double, 4, 2> q4_shape_derivatives(double xi, double eta) {
-  return Quad4::derivatives({xi, eta});
-}
+inline Eigen::Matrix<double, 4, 2> q4_shape_derivatives(double xi, double eta) { return Quad4::derivatives({xi, eta}); }
 // Gauss rule with n = 1..3 points per direction: (xi, eta, weight).
 std::vector<std::array<double, 3>> gauss_rule_2d(int n);
 inline ElementState q4_internal_force(const ElementCoords& X, const ElementVector& u, const Material& material,

@@ -24,7 +24,7 @@ using Matrix6 = Eigen::Matrix<double, 6, 6>;
 
 // Number of independent components of a symmetric dim x dim tensor (3 in 2D, 6 in 3D).
 template <int dim>
-inline constexpr int voigt_size = dim * (dim + 1) / 2;
+inline constexpr int voigt_size = dim*(dim + 1) / 2;
 
 template <int dim>
 struct KinematicsT {

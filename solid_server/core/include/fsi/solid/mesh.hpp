@@ -17,9 +17,9 @@ namespace fsi::solid {
 using Facet = std::vector<int>;  // 2 nodes (2D edge) or 4 nodes (3D quadrilateral face)
 
 struct SolidMesh {
-  int dim = 2;                                         // 2: plane strain Q4; 3: Hex8
-  Eigen::MatrixXd nodes;                               // reference coordinates, n x dim
-  std::vector<std::vector<int>> cells;                 // counter-clockwise Q4, or Hex8 (element.hpp's order)
+  int dim = 2;                                           // 2: plane strain Q4; 3: Hex8
+  Eigen::MatrixXd nodes;                                 // reference coordinates, n x dim
+  std::vector<std::vector<int>> cells;                   // counter-clockwise Q4, or Hex8 (element.hpp's order)
   std::map<std::string, std::vector<Facet>> facet_sets;  // boundary facets by name
 
   int num_nodes() const { return static_cast<int>(nodes.rows()); }
