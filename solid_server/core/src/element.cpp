@@ -1,6 +1,7 @@
 #include "fsi/solid/element.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
 #include <stdexcept>

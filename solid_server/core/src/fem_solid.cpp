@@ -292,8 +292,9 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   accepted_steps_ = 0;
   solved_ = false;
   log->info("fem solid: {}D, {} nodes, {} {} cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
-            dim, mesh_.num_nodes(), mesh_.num_cells(), element, system_->num_free(), material->name(), constants.mu,
-            constants.lambda, analysis, scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
+            dim, mesh_.num_nodes(), mesh_.num_cells(), element, system_->num_free(),
+            dim == 2 ? material->name() : material3->name(), constants.mu, constants.lambda, analysis,
+            scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
             setup.interface_damping > 0 ? fmt::format(", interface damping {:.4g}", setup.interface_damping) : "");
 }
 
