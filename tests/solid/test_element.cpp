@@ -126,7 +126,7 @@ TEST(PatchTest, UniformStressOnDistortedMesh) {
   for (int i = 0; i < n; ++i) exact.segment<2>(2 * i) = (F0 - Matrix2::Identity()) * mesh.nodes.row(i).transpose();
 
   std::vector<char> fixed(2 * n, 0);
-  for (int node : mesh.edge_nodes({"left", "right", "bottom", "top"})) fixed[2 * node] = fixed[2 * node + 1] = 1;
+  for (int node : mesh.facet_nodes({"left", "right", "bottom", "top"})) fixed[2 * node] = fixed[2 * node + 1] = 1;
   SolidSystem sys(mesh, mat, 1.0, fixed);
   const Eigen::VectorXd f = sys.internal_force(exact);
   // Boundary force: P = F S; on x = 1 face (N = e1, length 1), total = P e1.
@@ -136,7 +136,7 @@ TEST(PatchTest, UniformStressOnDistortedMesh) {
   S << Sv(0), Sv(2), Sv(2), Sv(1);
   const Matrix2 P = F0 * S;
   Eigen::Vector2d right_total = Eigen::Vector2d::Zero();
-  for (int node : mesh.edge_nodes({"right"})) right_total += f.segment<2>(2 * node);
+  for (int node : mesh.facet_nodes({"right"})) right_total += f.segment<2>(2 * node);
   // Corner nodes are shared with top/bottom: subtract their half-edge share of those faces.
   for (int node : {4, 24}) right_total -= 0.5 * 0.25 * P * (node == 4 ? Eigen::Vector2d(0, -1) : Eigen::Vector2d(0, 1));
   EXPECT_LT((right_total - P.col(0)).norm(), 1e-12);
@@ -171,7 +171,7 @@ double mms_error(int n) {
   const ElasticConstants c = ElasticConstants::from_youngs(1.0, 0.3);
   SolidMesh mesh = rectangle_mesh(0, 0, 1, 1, n, n);
   std::vector<char> fixed(2 * mesh.num_nodes(), 0);
-  for (int node : mesh.edge_nodes({"left", "right", "bottom", "top"})) fixed[2 * node] = fixed[2 * node + 1] = 1;
+  for (int node : mesh.facet_nodes({"left", "right", "bottom", "top"})) fixed[2 * node] = fixed[2 * node + 1] = 1;
   SolidSystem sys(mesh, std::make_shared<SaintVenantKirchhoff>(c), 1.0, fixed);
   auto phi = [pi](const Eigen::Vector2d& x) { return std::sin(pi * x(0)) * std::sin(pi * x(1)); };
   const Eigen::VectorXd f = sys.body_force([&](const Eigen::Vector2d& x) {

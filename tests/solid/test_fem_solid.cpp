@@ -155,7 +155,7 @@ TEST(InterfaceDamping, BoundaryMassIntegratesTheLength) {
   SolidMesh mesh = rectangle_mesh(0, 0, 2.0, 1.0, 5, 3);
   SolidSystem sys(mesh, std::make_shared<NeoHookean>(ElasticConstants::from_shear(1, 0.3)), 1.0,
                   std::vector<char>(2 * mesh.num_nodes(), 0));
-  const SparseMatrix C = sys.boundary_mass(mesh.edges({"top", "right"}), 7.0);
+  const SparseMatrix C = sys.boundary_mass(mesh.facets({"top", "right"}), 7.0);
   Eigen::VectorXd ones_x = Eigen::VectorXd::Zero(sys.num_dofs());
   for (int i = 0; i < mesh.num_nodes(); ++i) ones_x(2 * i) = 1;
   EXPECT_NEAR(ones_x.dot(C * ones_x), 7.0 * 3.0, 1e-12);  // gamma * (2 + 1)
@@ -206,7 +206,7 @@ solid:
       for (int i = 0; i < sys.mesh().num_nodes(); ++i) ones_x(2 * i) = 1;
       // int_boundary v_x ds, exactly (v is linear on each edge).
       double boundary_integral = 0;
-      for (const auto& e : sys.mesh().edges({"top", "right", "bottom", "left"}))
+      for (const auto& e : sys.mesh().facets({"top", "right", "bottom", "left"}))
         boundary_integral +=
             0.5 * (sys.mesh().nodes.row(e[0]) - sys.mesh().nodes.row(e[1])).norm() * (v(2 * e[0]) + v(2 * e[1]));
       EXPECT_NEAR(ones_x.dot(sys.damping() * v), g * boundary_integral,

@@ -1,6 +1,7 @@
 #include "fsi/solid/element.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
 #include <stdexcept>
@@ -11,21 +12,87 @@ namespace fsi::solid {
 namespace {
 constexpr double kXi[4] = {-1, 1, 1, -1};
 constexpr double kEta[4] = {-1, -1, 1, 1};
+// Hex8: the Q4's corners at zeta = -1, then at zeta = +1.
+constexpr double kHexXi[8] = {-1, 1, 1, -1, -1, 1, 1, -1};
+constexpr double kHexEta[8] = {-1, -1, 1, 1, -1, -1, 1, 1};
+constexpr double kHexZeta[8] = {-1, -1, -1, -1, 1, 1, 1, 1};
+const double kGauss = 1.0 / std::sqrt(3.0);
 }  // namespace
 
-Eigen::Vector4d q4_shape(double xi, double eta) {
+// ---------------------------------------------------------------- shapes
+Eigen::Matrix<double, 4, 1> Quad4::shape(const Point& p) {
   Eigen::Vector4d N;
-  for (int a = 0; a < 4; ++a) N(a) = 0.25 * (1 + kXi[a] * xi) * (1 + kEta[a] * eta);
+  for (int a = 0; a < 4; ++a) N(a) = 0.25 * (1 + kXi[a] * p(0)) * (1 + kEta[a] * p(1));
   return N;
 }
 
-Eigen::Matrix<double, 4, 2> q4_shape_derivatives(double xi, double eta) {
+Eigen::Matrix<double, 4, 2> Quad4::derivatives(const Point& p) {
   Eigen::Matrix<double, 4, 2> dN;
   for (int a = 0; a < 4; ++a) {
-    dN(a, 0) = 0.25 * kXi[a] * (1 + kEta[a] * eta);
-    dN(a, 1) = 0.25 * kEta[a] * (1 + kXi[a] * xi);
+    dN(a, 0) = 0.25 * kXi[a] * (1 + kEta[a] * p(1));
+    dN(a, 1) = 0.25 * kEta[a] * (1 + kXi[a] * p(0));
   }
   return dN;
+}
+
+const std::array<std::pair<Quad4::Point, double>, 4>& Quad4::gauss() {
+  static const std::array<std::pair<Point, double>, 4> rule = {
+      {{{-kGauss, -kGauss}, 1}, {{-kGauss, kGauss}, 1}, {{kGauss, -kGauss}, 1}, {{kGauss, kGauss}, 1}}};
+  return rule;
+}
+
+Eigen::Matrix<double, 3, 4> Quad4::enhanced_modes(const Point& p) {
+  Eigen::Matrix<double, 3, 4> M = Eigen::Matrix<double, 3, 4>::Zero();
+  M(0, 0) = p(0);
+  M(1, 1) = p(1);
+  M(2, 2) = p(0);
+  M(2, 3) = p(1);
+  return M;
+}
+
+Eigen::Matrix<double, 8, 1> Hex8::shape(const Point& p) {
+  Eigen::Matrix<double, 8, 1> N;
+  for (int a = 0; a < 8; ++a)
+    N(a) = 0.125 * (1 + kHexXi[a] * p(0)) * (1 + kHexEta[a] * p(1)) * (1 + kHexZeta[a] * p(2));
+  return N;
+}
+
+Eigen::Matrix<double, 8, 3> Hex8::derivatives(const Point& p) {
+  Eigen::Matrix<double, 8, 3> dN;
+  for (int a = 0; a < 8; ++a) {
+    const double fx = 1 + kHexXi[a] * p(0), fy = 1 + kHexEta[a] * p(1), fz = 1 + kHexZeta[a] * p(2);
+    dN(a, 0) = 0.125 * kHexXi[a] * fy * fz;
+    dN(a, 1) = 0.125 * kHexEta[a] * fx * fz;
+    dN(a, 2) = 0.125 * kHexZeta[a] * fx * fy;
+  }
+  return dN;
+}
+
+const std::array<std::pair<Hex8::Point, double>, 8>& Hex8::gauss() {
+  static const std::array<std::pair<Point, double>, 8> rule = [] {
+    std::array<std::pair<Point, double>, 8> r;
+    int g = 0;
+    for (double x : {-kGauss, kGauss})
+      for (double y : {-kGauss, kGauss})
+        for (double z : {-kGauss, kGauss}) r[static_cast<std::size_t>(g++)] = {Point(x, y, z), 1.0};
+    return r;
+  }();
+  return rule;
+}
+
+Eigen::Matrix<double, 6, 9> Hex8::enhanced_modes(const Point& p) {
+  // Natural strains [xixi, etaeta, zetazeta, 2 xieta, 2 etazeta, 2 xizeta].
+  Eigen::Matrix<double, 6, 9> M = Eigen::Matrix<double, 6, 9>::Zero();
+  M(0, 0) = p(0);
+  M(1, 1) = p(1);
+  M(2, 2) = p(2);
+  M(3, 3) = p(0);
+  M(3, 4) = p(1);
+  M(4, 5) = p(1);
+  M(4, 6) = p(2);
+  M(5, 7) = p(0);
+  M(5, 8) = p(2);
+  return M;
 }
 
 std::vector<std::array<double, 3>> gauss_rule_2d(int n) {
@@ -50,132 +117,177 @@ std::vector<std::array<double, 3>> gauss_rule_2d(int n) {
   return rule;
 }
 
+// ---------------------------------------------------------------- kernels
 namespace {
-const std::vector<std::array<double, 3>>& gauss2() {
-  static const auto rule = gauss_rule_2d(2);
-  return rule;
-}
 
-// Reference-configuration gradients dN/dX (4x2) and det of the Jacobian.
-double reference_gradients(const ElementCoords& X, double xi, double eta, Eigen::Matrix<double, 4, 2>& dNdX) {
-  const Eigen::Matrix<double, 4, 2> dN = q4_shape_derivatives(xi, eta);
-  const Eigen::Matrix2d Jac = X.transpose() * dN;  // dX/dxi
+// Reference-configuration gradients dN/dX (nodes x dim) and det of the Jacobian.
+template <class Shape>
+double reference_gradients(const typename ElementTraits<Shape>::Coords& X, const typename Shape::Point& xi,
+                           Eigen::Matrix<double, Shape::nodes, Shape::dim>& dNdX) {
+  using Tensor = typename ElementTraits<Shape>::Tensor;
+  const Eigen::Matrix<double, Shape::nodes, Shape::dim> dN = Shape::derivatives(xi);
+  const Tensor Jac = X.transpose() * dN;  // dX/dxi
   const double det = Jac.determinant();
   dNdX = dN * Jac.inverse();
   return det;
 }
-}  // namespace
 
-Matrix2 q4_deformation_gradient(const ElementCoords& X, const ElementVector& u, double xi, double eta) {
-  Eigen::Matrix<double, 4, 2> dNdX;
-  reference_gradients(X, xi, eta, dNdX);
-  const Eigen::Map<const Eigen::Matrix<double, 2, 4>> U(u.data());  // column per node
-  return Matrix2::Identity() + U * dNdX;
+// Voigt pairs of the strain rows: normal components first, then the shears.
+template <int dim>
+constexpr std::array<std::array<int, 2>, voigt_size<dim>> strain_pairs() {
+  if constexpr (dim == 2)
+    return {{{0, 0}, {1, 1}, {0, 1}}};
+  else
+    return {{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
 }
 
-ElementState q4_internal_force(const ElementCoords& X, const ElementVector& u, const Material& material,
-                               bool with_tangent) {
-  ElementState out;
-  const Eigen::Map<const Eigen::Matrix<double, 2, 4>> U(u.data());
-  for (const auto& [xi, eta, w] : gauss2()) {
-    Eigen::Matrix<double, 4, 2> dNdX;
-    const double detJ = reference_gradients(X, xi, eta, dNdX);
+// Nonlinear strain-displacement matrix: dE_voigt = B du (shears doubled).
+template <class Shape>
+Eigen::Matrix<double, voigt_size<Shape::dim>, ElementTraits<Shape>::dofs> strain_displacement(
+    const Eigen::Matrix<double, Shape::nodes, Shape::dim>& dNdX, const typename ElementTraits<Shape>::Tensor& F) {
+  constexpr int dim = Shape::dim;
+  constexpr auto pairs = strain_pairs<dim>();
+  Eigen::Matrix<double, voigt_size<dim>, ElementTraits<Shape>::dofs> B;
+  for (int a = 0; a < Shape::nodes; ++a)
+    for (int s = 0; s < voigt_size<dim>; ++s) {
+      const int i = pairs[s][0], j = pairs[s][1];
+      for (int c = 0; c < dim; ++c)
+        B(s, dim * a + c) = i == j ? F(c, i) * dNdX(a, i) : F(c, i) * dNdX(a, j) + F(c, j) * dNdX(a, i);
+    }
+  return B;
+}
+
+// Geometric stiffness int Grad N S Grad N^T dV on the diagonal dof blocks.
+template <class Shape>
+void add_geometric_stiffness(typename ElementTraits<Shape>::Matrix& K,
+                             const Eigen::Matrix<double, Shape::nodes, Shape::dim>& dNdX,
+                             const Eigen::Matrix<double, voigt_size<Shape::dim>, 1>& S, double dV) {
+  constexpr int dim = Shape::dim, n = Shape::nodes;
+  const Eigen::Matrix<double, dim, dim> Sm = from_voigt<dim>(S);
+  const Eigen::Matrix<double, n, n> G = dNdX * Sm * dNdX.transpose();  // per node pair
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      for (int c = 0; c < dim; ++c) K(dim * a + c, dim * b + c) += dV * G(a, b);
+}
+
+// Natural strains (Voigt, doubled shears) -> Cartesian strains with K = J^-1, K(A, j) = dxi_A/dX_j:
+// E_ij = K(A, i) K(B, j) E_AB.
+template <int dim>
+Eigen::Matrix<double, voigt_size<dim>, voigt_size<dim>> strain_transformation(
+    const Eigen::Matrix<double, dim, dim>& K) {
+  constexpr auto pairs = strain_pairs<dim>();
+  Eigen::Matrix<double, voigt_size<dim>, voigt_size<dim>> T;
+  for (int a = 0; a < voigt_size<dim>; ++a)
+    for (int b = 0; b < voigt_size<dim>; ++b) {
+      const int i = pairs[a][0], j = pairs[a][1], A = pairs[b][0], Bn = pairs[b][1];
+      if (i == j)
+        T(a, b) = K(A, i) * K(Bn, i);
+      else if (A == Bn)
+        T(a, b) = 2 * K(A, i) * K(A, j);
+      else
+        T(a, b) = K(A, i) * K(Bn, j) + K(Bn, i) * K(A, j);
+    }
+  return T;
+}
+
+}  // namespace
+
+template <class Shape>
+typename ElementTraits<Shape>::Tensor deformation_gradient(const typename ElementTraits<Shape>::Coords& X,
+                                                           const typename ElementTraits<Shape>::Vector& u,
+                                                           const typename Shape::Point& xi) {
+  constexpr int dim = Shape::dim;
+  Eigen::Matrix<double, Shape::nodes, dim> dNdX;
+  reference_gradients<Shape>(X, xi, dNdX);
+  const Eigen::Map<const Eigen::Matrix<double, dim, Shape::nodes>> U(u.data());  // column per node
+  return ElementTraits<Shape>::Tensor::Identity() + U * dNdX;
+}
+
+template <class Shape>
+ElementStateT<Shape> internal_force(const typename ElementTraits<Shape>::Coords& X,
+                                    const typename ElementTraits<Shape>::Vector& u,
+                                    const MaterialLaw<Shape::dim>& material, bool with_tangent) {
+  constexpr int dim = Shape::dim;
+  using Law = MaterialLaw<dim>;
+  ElementStateT<Shape> out;
+  const Eigen::Map<const Eigen::Matrix<double, dim, Shape::nodes>> U(u.data());
+  for (const auto& [xi, w] : Shape::gauss()) {
+    Eigen::Matrix<double, Shape::nodes, dim> dNdX;
+    const double detJ = reference_gradients<Shape>(X, xi, dNdX);
     out.min_det_jacobian = std::min(out.min_det_jacobian, detJ);
-    const Kinematics k = Kinematics::from_displacement_gradient(U * dNdX);
-    const Matrix2& F = k.F;
+    const KinematicsT<dim> k = KinematicsT<dim>::from_displacement_gradient(U * dNdX);
     out.min_det_F = std::min(out.min_det_F, k.J);
     if (!(k.J > 0)) continue;  // the caller reports; keep values finite
-    const Vector3 S = material.stress(k);
+    const typename Law::Stress S = material.stress(k);
     const double dV = w * detJ;
-    // Nonlinear strain-displacement matrix: dE_voigt = B du.
-    Eigen::Matrix<double, 3, 8> B;
-    for (int a = 0; a < 4; ++a) {
-      const double n1 = dNdX(a, 0), n2 = dNdX(a, 1);
-      B(0, 2 * a) = F(0, 0) * n1;
-      B(0, 2 * a + 1) = F(1, 0) * n1;
-      B(1, 2 * a) = F(0, 1) * n2;
-      B(1, 2 * a + 1) = F(1, 1) * n2;
-      B(2, 2 * a) = F(0, 0) * n2 + F(0, 1) * n1;
-      B(2, 2 * a + 1) = F(1, 0) * n2 + F(1, 1) * n1;
-    }
+    const auto B = strain_displacement<Shape>(dNdX, k.F);
     out.internal_force.noalias() += dV * B.transpose() * S;
     if (!with_tangent) continue;
-    const Matrix3 D = material.tangent(k);
+    const typename Law::Tangent D = material.tangent(k);
     out.tangent.noalias() += dV * B.transpose() * D * B;
-    Matrix2 Sm;
-    Sm << S(0), S(2), S(2), S(1);
-    const Eigen::Matrix4d G = dNdX * Sm * dNdX.transpose();  // geometric stiffness per node pair
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        out.tangent(2 * a, 2 * b) += dV * G(a, b);
-        out.tangent(2 * a + 1, 2 * b + 1) += dV * G(a, b);
-      }
+    add_geometric_stiffness<Shape>(out.tangent, dNdX, S, dV);
   }
   return out;
 }
 
-ElementState q4_eas_internal_force(const ElementCoords& X, const ElementVector& u, const Material& material,
-                                   bool with_tangent) {
-  // Strain transformation at the centre: natural (covariant) strains -> Voigt [E11, E22, 2 E12].
-  const Eigen::Matrix2d J0 = X.transpose() * q4_shape_derivatives(0, 0);  // dX/dxi
+template <class Shape>
+ElementStateT<Shape> eas_internal_force(const typename ElementTraits<Shape>::Coords& X,
+                                        const typename ElementTraits<Shape>::Vector& u,
+                                        const MaterialLaw<Shape::dim>& material, bool with_tangent) {
+  constexpr int dim = Shape::dim, nv = voigt_size<dim>, nm = Shape::eas_modes, nd = ElementTraits<Shape>::dofs;
+  using Tensor = typename ElementTraits<Shape>::Tensor;
+  using Law = MaterialLaw<dim>;
+  using Modes = Eigen::Matrix<double, nm, 1>;
+  using ModeMatrix = Eigen::Matrix<double, nm, nm>;
+  // Strain transformation at the centre: natural (covariant) strains -> Voigt strains.
+  const Tensor J0 = X.transpose() * Shape::derivatives(Shape::Point::Zero());  // dX/dxi
   const double det0 = J0.determinant();
-  const Eigen::Matrix2d K = J0.inverse();  // K(A, j) = dxi_A / dX_j
-  Eigen::Matrix3d T0;
-  T0 << K(0, 0) * K(0, 0), K(1, 0) * K(1, 0), K(0, 0) * K(1, 0), K(0, 1) * K(0, 1), K(1, 1) * K(1, 1),
-      K(0, 1) * K(1, 1), 2 * K(0, 0) * K(0, 1), 2 * K(1, 0) * K(1, 1), K(0, 0) * K(1, 1) + K(1, 0) * K(0, 1);
-  const Eigen::Map<const Eigen::Matrix<double, 2, 4>> U(u.data());
+  const Eigen::Matrix<double, nv, nv> T0 = strain_transformation<dim>(Tensor(J0.inverse()));
+  const Eigen::Map<const Eigen::Matrix<double, dim, Shape::nodes>> U(u.data());
   struct Point {
     double dV;
-    Eigen::Matrix<double, 3, 8> B;
-    Eigen::Matrix<double, 3, 4> G;
-    Eigen::Vector3d Ec;
-    Eigen::Matrix<double, 4, 2> dNdX;
-    Matrix2 F;
+    Eigen::Matrix<double, nv, nd> B;
+    Eigen::Matrix<double, nv, nm> G;
+    Eigen::Matrix<double, nv, 1> Ec;
+    Eigen::Matrix<double, Shape::nodes, dim> dNdX;
+    Tensor F;
   };
-  std::array<Point, 4> pts;
-  ElementState out;
+  std::array<Point, Shape::gauss_points> pts;
+  ElementStateT<Shape> out;
   int g = 0;
-  for (const auto& [xi, eta, w] : gauss2()) {
+  for (const auto& [xi, w] : Shape::gauss()) {
     Point& p = pts[static_cast<std::size_t>(g++)];
-    const double detJ = reference_gradients(X, xi, eta, p.dNdX);
+    const double detJ = reference_gradients<Shape>(X, xi, p.dNdX);
     out.min_det_jacobian = std::min(out.min_det_jacobian, detJ);
     p.dV = w * detJ;
-    const Kinematics kc = Kinematics::from_displacement_gradient(U * p.dNdX);
+    const KinematicsT<dim> kc = KinematicsT<dim>::from_displacement_gradient(U * p.dNdX);
     p.F = kc.F;
     out.min_det_F = std::min(out.min_det_F, kc.J);
-    p.Ec << kc.E(0, 0), kc.E(1, 1), 2 * kc.E(0, 1);
-    const Matrix2& F = p.F;
-    for (int a = 0; a < 4; ++a) {
-      const double n1 = p.dNdX(a, 0), n2 = p.dNdX(a, 1);
-      p.B(0, 2 * a) = F(0, 0) * n1;
-      p.B(0, 2 * a + 1) = F(1, 0) * n1;
-      p.B(1, 2 * a) = F(0, 1) * n2;
-      p.B(1, 2 * a + 1) = F(1, 1) * n2;
-      p.B(2, 2 * a) = F(0, 0) * n2 + F(0, 1) * n1;
-      p.B(2, 2 * a + 1) = F(1, 0) * n2 + F(1, 1) * n1;
+    constexpr auto pairs = strain_pairs<dim>();
+    for (int s = 0; s < nv; ++s) {
+      const int i = pairs[s][0], j = pairs[s][1];
+      p.Ec(s) = i == j ? kc.E(i, i) : 2 * kc.E(i, j);
     }
-    Eigen::Matrix<double, 3, 4> M = Eigen::Matrix<double, 3, 4>::Zero();
-    M(0, 0) = xi;
-    M(1, 1) = eta;
-    M(2, 2) = xi;
-    M(2, 3) = eta;
-    p.G = (det0 / detJ) * T0 * M;
+    p.B = strain_displacement<Shape>(p.dNdX, p.F);
+    p.G = (det0 / detJ) * T0 * Shape::enhanced_modes(xi);
   }
   if (!(out.min_det_F > 0)) return out;  // the caller reports the inverted element
-  auto kinematics = [](const Point& p, const Eigen::Vector3d& e) {
-    Matrix2 E;
-    E << e(0), 0.5 * e(2), 0.5 * e(2), e(1);
-    return Kinematics::from_green_lagrange(E, p.F);
+  auto kinematics = [](const Point& p, const Eigen::Matrix<double, nv, 1>& e) {
+    Tensor E = from_voigt<dim>(e);
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j)
+        if (i != j) E(i, j) *= 0.5;
+    return KinematicsT<dim>::from_green_lagrange(E, p.F);
   };
   // Local Newton for the enhanced parameters: h(alpha) = int G^T S dV = 0.
-  Eigen::Vector4d alpha = Eigen::Vector4d::Zero();
-  Eigen::Matrix4d Kaa;
+  Modes alpha = Modes::Zero();
+  ModeMatrix Kaa;
   for (int it = 0; it < 25; ++it) {
-    Eigen::Vector4d h = Eigen::Vector4d::Zero();
+    Modes h = Modes::Zero();
     Kaa.setZero();
     bool ok = true;
     for (const Point& p : pts) {
-      const Kinematics k = kinematics(p, p.Ec + p.G * alpha);
+      const KinematicsT<dim> k = kinematics(p, p.Ec + p.G * alpha);
       if (!(k.J > 0)) {
         ok = false;
         break;
@@ -187,7 +299,7 @@ ElementState q4_eas_internal_force(const ElementCoords& X, const ElementVector& 
       out.min_det_F = std::min(out.min_det_F, -1.0);
       return out;
     }
-    const Eigen::Vector4d step = Kaa.ldlt().solve(h);
+    const Modes step = Kaa.ldlt().solve(h);
     alpha -= step;
     if (!alpha.allFinite()) {
       out.min_det_F = std::min(out.min_det_F, -1.0);
@@ -196,58 +308,88 @@ ElementState q4_eas_internal_force(const ElementCoords& X, const ElementVector& 
     if (step.cwiseAbs().maxCoeff() <= 1e-15 + 1e-13 * alpha.cwiseAbs().maxCoeff()) break;
   }
   // Force and condensed tangent at the converged alpha.
-  Eigen::Matrix<double, 8, 4> Kua = Eigen::Matrix<double, 8, 4>::Zero();
+  Eigen::Matrix<double, nd, nm> Kua = Eigen::Matrix<double, nd, nm>::Zero();
   Kaa.setZero();
   for (const Point& p : pts) {
-    const Kinematics k = kinematics(p, p.Ec + p.G * alpha);
+    const KinematicsT<dim> k = kinematics(p, p.Ec + p.G * alpha);
     out.min_det_F = std::min(out.min_det_F, k.J);
     if (!(k.J > 0)) return out;
-    const Vector3 S = material.stress(k);
+    const typename Law::Stress S = material.stress(k);
     out.internal_force.noalias() += p.dV * p.B.transpose() * S;
     if (!with_tangent) continue;
-    const Matrix3 D = material.tangent(k);
+    const typename Law::Tangent D = material.tangent(k);
     out.tangent.noalias() += p.dV * p.B.transpose() * D * p.B;
     Kua.noalias() += p.dV * p.B.transpose() * D * p.G;
     Kaa.noalias() += p.dV * p.G.transpose() * D * p.G;
-    Matrix2 Sm;
-    Sm << S(0), S(2), S(2), S(1);
-    const Eigen::Matrix4d Gm = p.dNdX * Sm * p.dNdX.transpose();
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        out.tangent(2 * a, 2 * b) += p.dV * Gm(a, b);
-        out.tangent(2 * a + 1, 2 * b + 1) += p.dV * Gm(a, b);
-      }
+    add_geometric_stiffness<Shape>(out.tangent, p.dNdX, S, p.dV);
   }
   if (with_tangent) out.tangent.noalias() -= Kua * Kaa.ldlt().solve(Kua.transpose());
   return out;
 }
 
-ElementMatrix q4_mass(const ElementCoords& X, double density) {
-  ElementMatrix M = ElementMatrix::Zero();
-  for (const auto& [xi, eta, w] : gauss2()) {
-    Eigen::Matrix<double, 4, 2> dNdX;
-    const double dV = w * reference_gradients(X, xi, eta, dNdX);
-    const Eigen::Vector4d N = q4_shape(xi, eta);
-    const Eigen::Matrix4d m = density * dV * N * N.transpose();
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        M(2 * a, 2 * b) += m(a, b);
-        M(2 * a + 1, 2 * b + 1) += m(a, b);
-      }
+template <class Shape>
+typename ElementTraits<Shape>::Matrix element_mass(const typename ElementTraits<Shape>::Coords& X, double density) {
+  constexpr int dim = Shape::dim, n = Shape::nodes;
+  using Matrix = typename ElementTraits<Shape>::Matrix;
+  Matrix M = Matrix::Zero();
+  for (const auto& [xi, w] : Shape::gauss()) {
+    Eigen::Matrix<double, n, dim> dNdX;
+    const double dV = w * reference_gradients<Shape>(X, xi, dNdX);
+    const Eigen::Matrix<double, n, 1> N = Shape::shape(xi);
+    const Eigen::Matrix<double, n, n> m = density * dV * N * N.transpose();
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b)
+        for (int c = 0; c < dim; ++c) M(dim * a + c, dim * b + c) += m(a, b);
   }
   return M;
 }
 
-ElementVector q4_body_force(const ElementCoords& X, const Eigen::Vector2d& b) {
-  ElementVector f = ElementVector::Zero();
-  for (const auto& [xi, eta, w] : gauss2()) {
-    Eigen::Matrix<double, 4, 2> dNdX;
-    const double dV = w * reference_gradients(X, xi, eta, dNdX);
-    const Eigen::Vector4d N = q4_shape(xi, eta);
-    for (int a = 0; a < 4; ++a) f.segment<2>(2 * a) += dV * N(a) * b;
+template <class Shape>
+typename ElementTraits<Shape>::Vector element_body_force(const typename ElementTraits<Shape>::Coords& X,
+                                                         const Eigen::Matrix<double, Shape::dim, 1>& b) {
+  constexpr int dim = Shape::dim, n = Shape::nodes;
+  using Vector = typename ElementTraits<Shape>::Vector;
+  Vector f = Vector::Zero();
+  for (const auto& [xi, w] : Shape::gauss()) {
+    Eigen::Matrix<double, n, dim> dNdX;
+    const double dV = w * reference_gradients<Shape>(X, xi, dNdX);
+    const Eigen::Matrix<double, n, 1> N = Shape::shape(xi);
+    for (int a = 0; a < n; ++a) f.template segment<dim>(dim * a) += dV * N(a) * b;
   }
   return f;
 }
+
+template <class Shape>
+bool inverse_map(const typename ElementTraits<Shape>::Coords& X, const typename Shape::Point& p,
+                 typename Shape::Point& xi) {
+  using Tensor = typename ElementTraits<Shape>::Tensor;
+  using Point = typename Shape::Point;
+  xi.setZero();
+  for (int it = 0; it < 30; ++it) {
+    const Point x = X.transpose() * Shape::shape(xi);
+    const Tensor Jac = X.transpose() * Shape::derivatives(xi);
+    const Point dxi = Jac.inverse() * (p - x);
+    xi += dxi;
+    if (!xi.allFinite() || xi.cwiseAbs().maxCoeff() > 10) return false;
+    if (dxi.norm() < 1e-12) return true;
+  }
+  return xi.allFinite();  // converged to round-off
+}
+
+#define FSI_SOLID_INSTANTIATE(Shape)                                                                                   \
+  template ElementStateT<Shape> internal_force<Shape>(                                                                 \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool); \
+  template ElementStateT<Shape> eas_internal_force<Shape>(                                                             \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool); \
+  template ElementTraits<Shape>::Matrix element_mass<Shape>(const ElementTraits<Shape>::Coords&, double);              \
+  template ElementTraits<Shape>::Vector element_body_force<Shape>(const ElementTraits<Shape>::Coords&,                 \
+                                                                  const Eigen::Matrix<double, Shape::dim, 1>&);        \
+  template ElementTraits<Shape>::Tensor deformation_gradient<Shape>(                                                   \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const Shape::Point&);                  \
+  template bool inverse_map<Shape>(const ElementTraits<Shape>::Coords&, const Shape::Point&, Shape::Point&);
+FSI_SOLID_INSTANTIATE(Quad4)
+FSI_SOLID_INSTANTIATE(Hex8)
+#undef FSI_SOLID_INSTANTIATE
 
 Eigen::Matrix4d edge_mass(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double weight) {
   const double L = (b - a).norm();
@@ -258,17 +400,14 @@ Eigen::Matrix4d edge_mass(const Eigen::Vector2d& a, const Eigen::Vector2d& b, do
   return M;
 }
 
-bool q4_inverse_map(const ElementCoords& X, const Eigen::Vector2d& p, Eigen::Vector2d& xi) {
-  xi.setZero();
-  for (int it = 0; it < 30; ++it) {
-    const Eigen::Vector2d x = X.transpose() * q4_shape(xi(0), xi(1));
-    const Eigen::Matrix2d Jac = X.transpose() * q4_shape_derivatives(xi(0), xi(1));
-    const Eigen::Vector2d dxi = Jac.inverse() * (p - x);
-    xi += dxi;
-    if (!xi.allFinite() || xi.cwiseAbs().maxCoeff() > 10) return false;
-    if (dxi.norm() < 1e-12) return true;
+Eigen::Vector4d quad_face_weights(const Eigen::Matrix<double, 4, 3>& X) {
+  Eigen::Vector4d out = Eigen::Vector4d::Zero();
+  for (const auto& [xi, w] : Quad4::gauss()) {
+    const Eigen::Matrix<double, 4, 2> dN = Quad4::derivatives(xi);
+    const Eigen::Matrix<double, 3, 2> T = X.transpose() * dN;  // tangents
+    out += w * T.col(0).cross(T.col(1)).norm() * Quad4::shape(xi);
   }
-  return xi.allFinite();  // converged to round-off
+  return out;
 }
 
 }  // namespace fsi::solid

@@ -18,16 +18,38 @@ namespace fsi::solid {
 
 namespace {
 
-Eigen::Vector2d vec2(const schema::Reader& s, const std::string& key) {
-  const auto v = s.vector2(key);
-  return {v[0], v[1]};
+// A vector key of the mesh's dimension (fem_solid_keys.cpp's vector_key): [x, y] or [x, y, z];
+// absent: zero.
+Eigen::VectorXd vec(const schema::Reader& s, const std::string& key, int dim) {
+  if (!s.has(key)) return Eigen::VectorXd::Zero(dim);
+  std::vector<double> v;
+  try {
+    v = s.section().get<std::vector<double>>(key);
+  } catch (const ConfigError&) {
+    s.fail(key, fmt::format("must be a list of {} numbers", dim));
+  }
+  if (static_cast<int>(v.size()) != dim)
+    s.fail(key, fmt::format("has {} components, the mesh is {}D: give {}", v.size(), dim,
+                            dim == 2 ? "[x, y]" : "[x, y, z]"));
+  for (double x : v)
+    if (!std::isfinite(x)) s.fail(key, "must be finite");
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), dim);
 }
 
 SolidMesh build_mesh(const schema::Reader& m) {
   const auto type = m.get<std::string>("type");
+  if (type == "box") {
+    const Eigen::Vector3d origin = vec(m, "origin", 3);
+    const Eigen::Vector3d size = vec(m, "size", 3);
+    const auto n = m.get<std::vector<int>>("divisions");
+    if (n.size() != 3 || n[0] < 1 || n[1] < 1 || n[2] < 1)
+      m.fail("divisions", "must be [nx, ny, nz] with nx, ny, nz >= 1");
+    if (!(size.minCoeff() > 0)) m.fail("size", "must be positive");
+    return box_mesh(origin, size, n[0], n[1], n[2]);
+  }
   if (type == "rectangle") {
-    const Eigen::Vector2d origin = vec2(m, "origin");
-    const Eigen::Vector2d size = vec2(m, "size");
+    const Eigen::Vector2d origin = vec(m, "origin", 2);
+    const Eigen::Vector2d size = vec(m, "size", 2);
     const auto n = m.get<std::vector<int>>("elements");
     if (n.size() != 2 || n[0] < 1 || n[1] < 1) m.fail("elements", "must be [nx, ny] with nx, ny >= 1");
     if (!(size(0) > 0 && size(1) > 0)) m.fail("size", "must be positive");
@@ -46,7 +68,7 @@ SolidMesh build_mesh(const schema::Reader& m) {
     m.fail("type", "gmsh meshes need fsi::read_gmsh, not built into fsi_common yet ('" + file.string() + "')");
 #endif
   }
-  m.fail("type", "must be 'rectangle' or 'gmsh', got '" + type + "'");
+  m.fail("type", "must be 'rectangle', 'box' or 'gmsh', got '" + type + "'");
 }
 
 }  // namespace
@@ -56,8 +78,9 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   auto log = fsi::logger("solid");
   setup_ = setup;
 
-  // 1. Mesh.
+  // 1. Mesh; its dimension is the solid's.
   mesh_ = build_mesh(s.child("mesh"));
+  const int dim = mesh_.dim;
 
   // 2. Material.
   const auto mat = s.child("material");
@@ -75,8 +98,12 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
     constants = ElasticConstants::from_shear(mu, nu);
   }
   std::shared_ptr<const Material> material;
+  std::shared_ptr<const Material3> material3;
   try {
-    material = make_material(law, constants);
+    if (dim == 2)
+      material = make_material<2>(law, constants);
+    else
+      material3 = make_material<3>(law, constants);
   } catch (const std::invalid_argument& e) {
     mat.fail("law", e.what());
   }
@@ -115,53 +142,84 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   else if (solver_name != "cholmod")
     s.fail("linear_solver", "must be 'cholmod' or 'umfpack'");
 
-  // 5. Clamps (homogeneous Dirichlet on named edges, both components).
+  // 5. Clamps (homogeneous Dirichlet on named facets, every component) and supports (some
+  // components only, e.g. u_z = 0 on the side faces of an extruded 2D problem).
   const auto clamp = s.names("clamp");
-  std::vector<char> fixed(2 * mesh_.num_nodes(), 0);
+  std::vector<char> fixed(static_cast<std::size_t>(dim * mesh_.num_nodes()), 0);
   try {
-    for (int n : mesh_.edge_nodes(clamp)) fixed[2 * n] = fixed[2 * n + 1] = 1;
+    for (int n : mesh_.facet_nodes(clamp))
+      for (int c = 0; c < dim; ++c) fixed[static_cast<std::size_t>(dim * n + c)] = 1;
   } catch (const std::invalid_argument& e) {
     s.fail("clamp", e.what());
   }
-  system_ = std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind);
-  const auto element = s.get<std::string>("element");
-  if (element == "q4_eas")
-    system_->set_element(ElementKind::Q4Eas);
-  else if (element != "q4")
-    s.fail("element", "must be 'q4' (bilinear) or 'q4_eas' (enhanced assumed strain), got '" + element + "'");
+  for (const auto& support : s.list("supports")) {
+    std::vector<int> nodes;
+    try {
+      nodes = mesh_.facet_nodes(support.names("boundary"));
+    } catch (const std::invalid_argument& e) {
+      support.fail("boundary", e.what());
+    }
+    const std::string axes = dim == 2 ? "xy" : "xyz";
+    for (const auto& component : support.names("fixed")) {
+      const auto c = axes.find(component);
+      if (component.size() != 1 || c == std::string::npos)
+        support.fail("fixed", fmt::format("'{}' is not a component of a {}D mesh (give some of {})", component, dim,
+                                          dim == 2 ? "x, y" : "x, y, z"));
+      for (int n : nodes) fixed[static_cast<std::size_t>(dim * n) + c] = 1;
+    }
+  }
+  system_ = dim == 2 ? std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind)
+                     : std::make_unique<SolidSystem>(mesh_, material3, density, fixed, solver_kind);
+  const auto element = s.get_or<std::string>("element", dim == 2 ? "q4" : "hex8");
+  const std::map<std::string, ElementKind> elements =
+      dim == 2 ? std::map<std::string, ElementKind>{{"q4", ElementKind::Q4}, {"q4_eas", ElementKind::Q4Eas}}
+               : std::map<std::string, ElementKind>{{"hex8", ElementKind::Hex8}, {"h8_eas", ElementKind::Hex8Eas}};
+  if (!elements.count(element))
+    s.fail("element", fmt::format("'{}' is not an element of a {}D mesh (give {})", element, dim,
+                                  dim == 2 ? "q4 or q4_eas" : "hex8 or h8_eas"));
+  system_->set_element(elements.at(element));
 
-  // 6. Loads: gravity (force per reference volume rho_s g), dead edge tractions, point loads.
-  const Eigen::Vector2d gravity = vec2(s, "gravity");
-  dead_load_ = system_->body_force(Eigen::Vector2d(density * gravity));
+  // 6. Loads: gravity (force per reference volume rho_s g), dead facet tractions, point loads.
+  const Eigen::VectorXd gravity = vec(s, "gravity", dim);
+  dead_load_ = system_->body_force(Eigen::VectorXd(density * gravity));
   for (const auto& t : s.list("tractions")) {
     const auto boundary = t.names("boundary");
-    const Eigen::Vector2d traction = vec2(t, "traction");  // force per reference length
-    std::vector<std::array<int, 2>> edges;
+    const Eigen::VectorXd traction = vec(t, "traction", dim);  // force per reference length (2D) or area (3D)
+    std::vector<Facet> facets;
     try {
-      edges = mesh_.edges(boundary);
+      facets = mesh_.facets(boundary);
     } catch (const std::invalid_argument& e) {
       t.fail("boundary", e.what());
     }
-    for (const auto& e : edges) {
-      const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
-      for (int n : e) dead_load_.segment<2>(2 * n) += 0.5 * L * traction;
+    for (const auto& e : facets) {
+      if (dim == 2) {
+        const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
+        for (int n : e) dead_load_.segment<2>(2 * n) += 0.5 * L * traction;
+      } else {
+        Eigen::Matrix<double, 4, 3> X;
+        for (int a = 0; a < 4; ++a) X.row(a) = mesh_.nodes.row(e[static_cast<std::size_t>(a)]);
+        const Eigen::Vector4d w = quad_face_weights(X);
+        for (int a = 0; a < 4; ++a) dead_load_.segment<3>(3 * e[static_cast<std::size_t>(a)]) += w(a) * traction;
+      }
     }
   }
 
   for (const auto& p : s.list("point_loads")) {  // force at the node nearest to a point
-    const Eigen::Vector2d point = vec2(p, "point");
-    const Eigen::Vector2d force = vec2(p, "force");
+    const Eigen::VectorXd point = vec(p, "point", dim);
+    const Eigen::VectorXd force = vec(p, "force", dim);
     Eigen::Index nearest = 0;
     (mesh_.nodes.rowwise() - point.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
-    dead_load_.segment<2>(2 * nearest) += force;
+    dead_load_.segment(dim * nearest, dim) += force;
   }
 
   // 7. Interface: named edges -> InterfaceMeshData; Algorithm 2 damping on them.
   const auto iface = s.names("interface");
-  std::vector<std::array<int, 2>> iface_edges;
+  if (dim == 3 && !iface.empty())
+    s.fail("interface", "coupling faces of a 3D solid mesh are not supported yet (run it standalone)");
+  std::vector<Facet> iface_edges;
   try {
-    iface_edges = mesh_.edges(iface);
-    interface_nodes_ = mesh_.edge_nodes(iface);
+    iface_edges = mesh_.facets(iface);
+    interface_nodes_ = mesh_.facet_nodes(iface);
   } catch (const std::invalid_argument& e) {
     s.fail("interface", e.what());
   }
@@ -198,11 +256,19 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   for (const auto& p : s.list("probes")) {
     Probe probe;
     probe.name = p.get<std::string>("name");
-    probe.point = vec2(p, "point");
-    double best = 1e300;  // the cell whose natural coordinates are closest to [-1, 1]^2
+    probe.point = vec(p, "point", dim);
+    double best = 1e300;  // the cell whose natural coordinates are closest to [-1, 1]^dim
     for (int c = 0; c < mesh_.num_cells(); ++c) {
-      Eigen::Vector2d xi;
-      if (!q4_inverse_map(system_->cell_coordinates(c), probe.point, xi)) continue;
+      Eigen::VectorXd xi;
+      if (dim == 2) {
+        Eigen::Vector2d x2;
+        if (!inverse_map<Quad4>(system_->cell_coordinates<Quad4>(c), probe.point, x2)) continue;
+        xi = x2;
+      } else {
+        Eigen::Vector3d x3;
+        if (!inverse_map<Hex8>(system_->cell_coordinates<Hex8>(c), probe.point, x3)) continue;
+        xi = x3;
+      }
       const double outside = xi.cwiseAbs().maxCoeff();
       if (outside < best) best = outside, probe.cell = c, probe.xi = xi;
     }
@@ -225,9 +291,10 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   d_nm1_ = d_n_, v_nm1_ = v_n_;
   accepted_steps_ = 0;
   solved_ = false;
-  log->info("fem solid: {} nodes, {} {} cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
-            mesh_.num_nodes(), mesh_.num_cells(), element, system_->num_free(), material->name(), constants.mu,
-            constants.lambda, analysis, scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
+  log->info("fem solid: {}D, {} nodes, {} {} cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
+            dim, mesh_.num_nodes(), mesh_.num_cells(), element, system_->num_free(),
+            dim == 2 ? material->name() : material3->name(), constants.mu, constants.lambda, analysis,
+            scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
             setup.interface_damping > 0 ? fmt::format(", interface damping {:.4g}", setup.interface_damping) : "");
 }
 
@@ -239,12 +306,13 @@ void FemSolid::set_interface_mass(const NodalMatrix& m) {
         fmt::format("solid: interface mass is {} x {}, expected {} x {} (interface nodes)", m.rows(), m.cols(), n, n));
   if (!(setup_.interface_damping > 0)) return;  // no damping (Algorithm 1 or gamma_N1 = 0)
   std::vector<Eigen::Triplet<double>> t;
-  t.reserve(2 * static_cast<std::size_t>(m.nonZeros()));
+  const int dim = mesh_.dim;
+  t.reserve(static_cast<std::size_t>(dim * m.nonZeros()));
   for (int col = 0; col < m.outerSize(); ++col)
     for (NodalMatrix::InnerIterator it(m, col); it; ++it)
-      for (int c = 0; c < 2; ++c)
-        t.emplace_back(2 * interface_nodes_[static_cast<std::size_t>(it.row())] + c,
-                       2 * interface_nodes_[static_cast<std::size_t>(it.col())] + c,
+      for (int c = 0; c < dim; ++c)
+        t.emplace_back(dim * interface_nodes_[static_cast<std::size_t>(it.row())] + c,
+                       dim * interface_nodes_[static_cast<std::size_t>(it.col())] + c,
                        setup_.interface_damping * it.value());
   system_->set_damping_entries(t);
 }
@@ -253,10 +321,12 @@ Eigen::VectorXd FemSolid::external_force(const Eigen::VectorXd& interface_force)
   Eigen::VectorXd f = dead_load_;
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   if (interface_force.size() == 0) return f;
-  if (interface_force.size() != 2 * n)
-    throw SolverError(fmt::format("solid: interface force has {} entries, expected {} (2 per interface node)",
-                                  interface_force.size(), 2 * n));
-  for (Eigen::Index i = 0; i < n; ++i) f.segment<2>(2 * interface_nodes_[i]) += interface_force.segment<2>(2 * i);
+  const int dim = mesh_.dim;
+  if (interface_force.size() != dim * n)
+    throw SolverError(fmt::format("solid: interface force has {} entries, expected {} ({} per interface node)",
+                                  interface_force.size(), dim * n, dim));
+  for (Eigen::Index i = 0; i < n; ++i)
+    f.segment(dim * interface_nodes_[i], dim) += interface_force.segment(dim * i, dim);
   return f;
 }
 
@@ -328,17 +398,25 @@ SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd
   solved_ = true;
   SolidStepResult r;
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
-  r.interface_displacement.resize(2 * n);
-  r.interface_velocity.resize(2 * n);
+  const int dim = mesh_.dim;
+  r.interface_displacement.resize(dim * n);
+  r.interface_velocity.resize(dim * n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    r.interface_displacement.segment<2>(2 * i) = d_.segment<2>(2 * interface_nodes_[i]);
-    r.interface_velocity.segment<2>(2 * i) = v_.segment<2>(2 * interface_nodes_[i]);
+    r.interface_displacement.segment(dim * i, dim) = d_.segment(dim * interface_nodes_[i], dim);
+    r.interface_velocity.segment(dim * i, dim) = v_.segment(dim * interface_nodes_[i], dim);
   }
   r.newton_iterations = last_iterations_;
   return r;
 }
 
-Eigen::Vector2d FemSolid::probe_displacement(const Probe& p, const Eigen::VectorXd& d) const {
+Eigen::VectorXd FemSolid::probe_displacement(const Probe& p, const Eigen::VectorXd& d) const {
+  if (mesh_.dim == 3) {
+    const auto N = Hex8::shape(p.xi);
+    const auto u = system_->cell_values<Hex8>(p.cell, d);
+    Eigen::Vector3d out = Eigen::Vector3d::Zero();
+    for (int a = 0; a < 8; ++a) out += N(a) * u.segment<3>(3 * a);
+    return out;
+  }
   const Eigen::Vector4d N = q4_shape(p.xi(0), p.xi(1));
   const auto u = system_->cell_values(p.cell, d);
   Eigen::Vector2d out = Eigen::Vector2d::Zero();
@@ -354,9 +432,10 @@ std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
   solved_ = false;
   std::map<std::string, double> probes;
   for (const auto& p : probes_) {
-    const Eigen::Vector2d u = probe_displacement(p, d_n_);
+    const Eigen::VectorXd u = probe_displacement(p, d_n_);
     probes[p.name + "_x"] = u(0);
     probes[p.name + "_y"] = u(1);
+    if (u.size() == 3) probes[p.name + "_z"] = u(2);
   }
   probes["newton_iterations"] = last_iterations_;
   return probes;
@@ -394,15 +473,34 @@ std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
   if (!series_ || info.step % output_every_ != 0) return {};
   VtkGrid grid;
   grid.points = mesh_.nodes;
-  const int nn = mesh_.num_nodes(), nc = mesh_.num_cells();
+  const int nn = mesh_.num_nodes(), nc = mesh_.num_cells(), dim = mesh_.dim;
   grid.point_data["displacement"] =
-      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(d_n_.data(), nn, 2);
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(d_n_.data(), nn, dim);
   grid.point_data["velocity"] =
-      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(v_n_.data(), nn, 2);
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(v_n_.data(), nn, dim);
+  for (int c = 0; c < nc; ++c) {
+    grid.cells.push_back(mesh_.cells[c]);
+    grid.cell_types.push_back(dim == 2 ? VtkCellType::Quad : VtkCellType::Hexahedron);
+  }
+  if (dim == 3) {  // Cauchy stress at the centre: the full 3x3 tensor (row major) and von Mises
+    Eigen::MatrixXd tensor(nc, 9);
+    Eigen::VectorXd mises(nc);
+    for (int c = 0; c < nc; ++c) {
+      const Eigen::Matrix3d F = deformation_gradient<Hex8>(
+          system_->cell_coordinates<Hex8>(c), system_->cell_values<Hex8>(c, d_n_), Eigen::Vector3d::Zero());
+      const Kinematics3 k = Kinematics3::from_deformation_gradient(F);
+      Eigen::Matrix3d sigma = Eigen::Matrix3d::Constant(NAN);
+      if (k.J > 0) sigma = from_voigt<3>(cauchy_stress<3>(k, system_->material3().stress(k)));
+      tensor.row(c) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(Eigen::Matrix3d(sigma.transpose()).data());
+      const Eigen::Matrix3d dev = sigma - sigma.trace() / 3.0 * Eigen::Matrix3d::Identity();
+      mises(c) = std::sqrt(1.5 * (dev.array() * dev.array()).sum());
+    }
+    grid.cell_data["cauchy_stress"] = tensor;
+    grid.cell_data["von_mises_stress"] = mises;
+    return {series_->write(info.time, info.step, grid).string()};
+  }
   Eigen::MatrixXd stress(nc, 3);
   for (int c = 0; c < nc; ++c) {
-    grid.cells.push_back({mesh_.cells[c].begin(), mesh_.cells[c].end()});
-    grid.cell_types.push_back(VtkCellType::Quad);
     const Matrix2 F = q4_deformation_gradient(system_->cell_coordinates(c), system_->cell_values(c, d_n_), 0, 0);
     const Kinematics k = Kinematics::from_deformation_gradient(F);
     stress.row(c) = k.J > 0 ? Eigen::RowVector3d(cauchy_stress(k, system_->material().stress(k)).transpose())

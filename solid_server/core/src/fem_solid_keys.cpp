@@ -4,23 +4,41 @@
 
 namespace fsi::solid {
 
+namespace {
+// A vector of the mesh's dimension, [x, y] or [x, y, z]. The scene schema's [x, y] type takes 2
+// numbers only (for now), so this declares a plain list and fem_solid.cpp's vec() checks the
+// count against the mesh where it reads the key.
+schema::Key vector_key(std::string name, std::string meaning) {
+  return schema::string_list(std::move(name), std::move(meaning) + "; [x, y] or [x, y, z] as the mesh");
+}
+}  // namespace
+
 const std::vector<schema::Key>& fem_solid_keys() {
   using namespace schema;
   static const std::vector<Key> keys = {
       section(
           "mesh", "the solid mesh",
           {
-              choice("type", {"rectangle", "gmsh"}, "built-in structured Q4 rectangle, or a gmsh .msh file").req(),
-              vector2("origin", "lower-left corner").req().only_when("type", {"rectangle"}).in_unit("m"),
-              vector2("size", "lx, ly (positive)").req().only_when("type", {"rectangle"}).in_unit("m"),
+              choice("type", {"rectangle", "box", "gmsh"},
+                     "built-in structured Q4 rectangle (2D), Hex8 box (3D), or a gmsh .msh file (2D)")
+                  .req(),
+              vector_key("origin", "lower-left (back) corner")
+                  .req()
+                  .only_when("type", {"rectangle", "box"})
+                  .in_unit("m"),
+              vector_key("size", "lx, ly (, lz) (positive)").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
               int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
                   .req()
                   .only_when("type", {"rectangle"}),
+              int_list("divisions", 3,
+                       "nx, ny, nz Hex8 cells (>= 1); face sets left, right (x), bottom, top (y), back, front (z)")
+                  .req()
+                  .only_when("type", {"box"}),
               text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
               text("domain", "2D physical group of the solid; default: every quad group").only_when("type", {"gmsh"}),
           })
           .req(),
-      section("material", "hyperelastic material (plane strain); exactly one of youngs_modulus, shear_modulus",
+      section("material", "hyperelastic material (plane strain in 2D); exactly one of youngs_modulus, shear_modulus",
               {
                   choice("law", {"saint_venant_kirchhoff", "svk", "neo_hookean"}, "material law").req(),
                   number("poisson_ratio", "nu").req().gt(-1).lt(0.5),
@@ -28,11 +46,12 @@ const std::vector<schema::Key>& fem_solid_keys() {
                   number("shear_modulus", "mu").gt(0).group("modulus").in_unit("Pa"),
               })
           .req(),
-      choice("element", {"q4", "q4_eas"},
-             "bilinear Q4, or Q4 with enhanced assumed strains (no shear locking in bending; same nodes)")
-          .def("q4"),
+      choice("element", {"q4", "q4_eas", "hex8", "h8_eas"},
+             "2D: bilinear Q4, or Q4 with enhanced assumed strains (no shear locking in bending; same nodes); "
+             "3D: trilinear Hex8, or Hex8 with 9 enhanced strain modes")
+          .def_computed("q4 (2D), hex8 (3D)"),
       number("density", "rho_s, reference configuration").req().gt(0).in_unit("kg/m^3"),
-      vector2("gravity", "body force per unit mass").def("[0, 0]").in_unit("m/s^2"),
+      vector_key("gravity", "body force per unit mass").def_computed("0 (every component)").in_unit("m/s^2"),
       choice("analysis", {"static", "dynamic"}, "equilibrium every step, or dynamics").def("dynamic"),
       choice("time_scheme", {"bdf1", "bdf2", "newmark"},
              "dynamic analysis: BDF1 (the paper), BDF2 or Newmark "
@@ -46,24 +65,30 @@ const std::vector<schema::Key>& fem_solid_keys() {
                   number("increment_tolerance", "or |du| <= tol * |u|").def("1e-10").ge(0),
               }),
       choice("linear_solver", {"cholmod", "umfpack"}, "sparse solver of the tangent").def("cholmod"),
-      names("clamp", "edge set(s) with u = 0").def("none"),
+      names("clamp", "facet set(s) (edges in 2D, faces in 3D) with u = 0").def("none"),
+      section_list("supports", "facet sets with some displacement components held at 0",
+                   {
+                       names("boundary", "facet set(s)").req(),
+                       names("fixed", "the components held: x, y (, z)").req(),
+                   })
+          .def("[]"),
       names("interface", "edge set(s) on the fluid side (coupling, Algorithm 2 damping)").def("none"),
       section_list("tractions", "dead edge loads",
                    {
-                       names("boundary", "edge set(s)").req(),
-                       vector2("traction", "force per reference length").req().in_unit("N/m"),
+                       names("boundary", "facet set(s)").req(),
+                       vector_key("traction", "force per reference length (2D) or area (3D)").req().in_unit("N/m"),
                    })
           .def("[]"),
       section_list("point_loads", "dead loads at the node nearest to a point",
                    {
-                       vector2("point", "where").req().in_unit("m"),
-                       vector2("force", "the load").req().in_unit("N"),
+                       vector_key("point", "where").req().in_unit("m"),
+                       vector_key("force", "the load").req().in_unit("N"),
                    })
           .def("[]"),
-      section_list("probes", "displacement of points (probes NAME_x, NAME_y)",
+      section_list("probes", "displacement of points (probes NAME_x, NAME_y, and NAME_z in 3D)",
                    {
                        text("name", "probe name").req(),
-                       vector2("point", "a point inside the mesh").req().in_unit("m"),
+                       vector_key("point", "a point inside the mesh").req().in_unit("m"),
                    })
           .def("[]"),
       integer("output_every", "VTK when the run writes output (time.output_every) and step % N == 0; 0 = never")

@@ -9,19 +9,19 @@
 
 namespace fsi::solid {
 
-std::vector<std::string> SolidMesh::edge_set_names() const {
+std::vector<std::string> SolidMesh::facet_set_names() const {
   std::vector<std::string> names;
-  for (const auto& [name, _] : edge_sets) names.push_back(name);
+  for (const auto& [name, _] : facet_sets) names.push_back(name);
   return names;
 }
 
-std::vector<std::array<int, 2>> SolidMesh::edges(const std::vector<std::string>& names) const {
-  std::vector<std::array<int, 2>> out;
+std::vector<Facet> SolidMesh::facets(const std::vector<std::string>& names) const {
+  std::vector<Facet> out;
   for (const auto& name : names) {
-    auto it = edge_sets.find(name);
-    if (it == edge_sets.end()) {
+    auto it = facet_sets.find(name);
+    if (it == facet_sets.end()) {
       std::string known;
-      for (const auto& n : edge_set_names()) known += (known.empty() ? "" : ", ") + n;
+      for (const auto& n : facet_set_names()) known += (known.empty() ? "" : ", ") + n;
       throw std::invalid_argument("no boundary named '" + name + "' in the mesh (known: " + known + ")");
     }
     out.insert(out.end(), it->second.begin(), it->second.end());
@@ -29,10 +29,10 @@ std::vector<std::array<int, 2>> SolidMesh::edges(const std::vector<std::string>&
   return out;
 }
 
-std::vector<int> SolidMesh::edge_nodes(const std::vector<std::string>& names) const {
+std::vector<int> SolidMesh::facet_nodes(const std::vector<std::string>& names) const {
   std::vector<int> out;
   std::set<int> seen;
-  for (const auto& e : edges(names))
+  for (const auto& e : facets(names))
     for (int n : e)
       if (seen.insert(n).second) out.push_back(n);
   return out;
@@ -42,19 +42,20 @@ SolidMesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int
   if (nx < 1 || ny < 1) throw std::invalid_argument("rectangle_mesh: need at least 1 x 1 elements");
   SolidMesh m;
   m.nodes.resize((nx + 1) * (ny + 1), 2);
+  m.dim = 2;
   auto id = [nx](int i, int j) { return j * (nx + 1) + i; };
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) m.nodes.row(id(i, j)) << x0 + lx * i / nx, y0 + ly * j / ny;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) m.cells.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-  auto& bottom = m.edge_sets["bottom"];
-  auto& top = m.edge_sets["top"];
+  auto& bottom = m.facet_sets["bottom"];
+  auto& top = m.facet_sets["top"];
   for (int i = 0; i < nx; ++i) {
     bottom.push_back({id(i, 0), id(i + 1, 0)});
     top.push_back({id(i + 1, ny), id(i, ny)});
   }
-  auto& left = m.edge_sets["left"];
-  auto& right = m.edge_sets["right"];
+  auto& left = m.facet_sets["left"];
+  auto& right = m.facet_sets["right"];
   for (int j = 0; j < ny; ++j) {
     right.push_back({id(nx, j), id(nx, j + 1)});
     left.push_back({id(0, j + 1), id(0, j)});
@@ -62,11 +63,46 @@ SolidMesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int
   return m;
 }
 
+SolidMesh box_mesh(const Eigen::Vector3d& origin, const Eigen::Vector3d& size, int nx, int ny, int nz) {
+  if (nx < 1 || ny < 1 || nz < 1) throw std::invalid_argument("box_mesh: need at least 1 x 1 x 1 elements");
+  SolidMesh m;
+  m.dim = 3;
+  m.nodes.resize((nx + 1) * (ny + 1) * (nz + 1), 3);
+  auto id = [nx, ny](int i, int j, int k) { return (k * (ny + 1) + j) * (nx + 1) + i; };
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i)
+        m.nodes.row(id(i, j, k)) << origin(0) + size(0) * i / nx, origin(1) + size(1) * j / ny,
+            origin(2) + size(2) * k / nz;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        m.cells.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1),
+                           id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
+  // Faces counter-clockwise seen from outside (outward normal by the right-hand rule).
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j) {
+      m.facet_sets["left"].push_back({id(0, j, k), id(0, j, k + 1), id(0, j + 1, k + 1), id(0, j + 1, k)});
+      m.facet_sets["right"].push_back({id(nx, j, k), id(nx, j + 1, k), id(nx, j + 1, k + 1), id(nx, j, k + 1)});
+    }
+  for (int k = 0; k < nz; ++k)
+    for (int i = 0; i < nx; ++i) {
+      m.facet_sets["bottom"].push_back({id(i, 0, k), id(i + 1, 0, k), id(i + 1, 0, k + 1), id(i, 0, k + 1)});
+      m.facet_sets["top"].push_back({id(i, ny, k), id(i, ny, k + 1), id(i + 1, ny, k + 1), id(i + 1, ny, k)});
+    }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      m.facet_sets["back"].push_back({id(i, j, 0), id(i, j + 1, 0), id(i + 1, j + 1, 0), id(i + 1, j, 0)});
+      m.facet_sets["front"].push_back({id(i, j, nz), id(i + 1, j, nz), id(i + 1, j + 1, nz), id(i, j + 1, nz)});
+    }
+  return m;
+}
+
 void distort_interior(SolidMesh& mesh, double fraction, unsigned seed) {
   // Boundary nodes: those on any edge set.
   std::set<int> boundary;
-  for (const auto& [_, edges] : mesh.edge_sets)
-    for (const auto& e : edges) boundary.insert(e.begin(), e.end());
+  for (const auto& [_, facets] : mesh.facet_sets)
+    for (const auto& e : facets) boundary.insert(e.begin(), e.end());
   double h = 1e300;
   for (const auto& c : mesh.cells)
     for (int a = 0; a < 4; ++a) h = std::min(h, (mesh.nodes.row(c[a]) - mesh.nodes.row(c[(a + 1) % 4])).norm());
@@ -76,10 +112,11 @@ void distort_interior(SolidMesh& mesh, double fraction, unsigned seed) {
     return 2.0 * (state >> 8) / double(1u << 24) - 1.0;
   };
   for (int n = 0; n < mesh.num_nodes(); ++n) {
-    const double dx = next(), dy = next();
+    const double dx = next(), dy = next(), dz = mesh.dim == 3 ? next() : 0.0;
     if (boundary.count(n)) continue;
     mesh.nodes(n, 0) += fraction * h * dx;
     mesh.nodes(n, 1) += fraction * h * dy;
+    if (mesh.dim == 3) mesh.nodes(n, 2) += fraction * h * dz;
   }
 }
 
@@ -111,7 +148,7 @@ SolidMesh mesh_from_gmsh(const GmshMesh& gmsh, const std::string& domain) {
     if (g.dimension != 1) continue;
     if (g.element_type != 1)
       throw std::invalid_argument("gmsh group '" + g.name + "': only 2-node lines (type 1) are supported");
-    auto& set = m.edge_sets[g.name];
+    auto& set = m.facet_sets[g.name];
     for (Eigen::Index e = 0; e < g.elements.rows(); ++e) {
       const int a = g.elements(e, 0), b = g.elements(e, 1);
       if (renumber.at(a) < 0 || renumber.at(b) < 0)
@@ -119,6 +156,7 @@ SolidMesh mesh_from_gmsh(const GmshMesh& gmsh, const std::string& domain) {
       set.push_back({renumber[a], renumber[b]});
     }
   }
+  m.dim = 2;
   m.nodes.resize(count, 2);
   for (std::size_t n = 0; n < renumber.size(); ++n)
     if (renumber[n] >= 0) m.nodes.row(renumber[n]) = gmsh.nodes.row(static_cast<Eigen::Index>(n));

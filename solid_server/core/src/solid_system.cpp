@@ -48,6 +48,15 @@ Eigen::VectorXd SparseDirectSolver::solve(const Eigen::VectorXd& b) const {
 }
 
 // ---------------------------------------------------------------- system
+namespace {
+// Calls f(Quad4{}) on a 2D mesh and f(Hex8{}) on a 3D one: the loops below are written once.
+template <class F>
+decltype(auto) with_shape(int dim, F&& f) {
+  if (dim == 3) return f(Hex8{});
+  return f(Quad4{});
+}
+}  // namespace
+
 InvertedElement::InvertedElement(int e, double det)
     : std::runtime_error("element " + std::to_string(e) + ": det F = " + std::to_string(det) + " <= 0"),
       element(e),
@@ -56,7 +65,30 @@ InvertedElement::InvertedElement(int e, double det)
 SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> material, double density,
                          std::vector<char> fixed_dofs, LinearSolverKind solver)
     : mesh_(mesh), material_(std::move(material)), density_(density), fixed_(std::move(fixed_dofs)), solver_(solver) {
+  if (mesh_.dim != 2) throw std::invalid_argument("SolidSystem: a 2D material law needs a 2D mesh");
+  initialise();
+}
+
+SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material3> material, double density,
+                         std::vector<char> fixed_dofs, LinearSolverKind solver)
+    : mesh_(mesh), material3_(std::move(material)), density_(density), fixed_(std::move(fixed_dofs)), solver_(solver) {
+  if (mesh_.dim != 3) throw std::invalid_argument("SolidSystem: a 3D material law needs a 3D mesh");
+  element_ = ElementKind::Hex8;
+  initialise();
+}
+
+void SolidSystem::set_element(ElementKind kind) {
+  const bool three_d = kind == ElementKind::Hex8 || kind == ElementKind::Hex8Eas;
+  if (three_d != (mesh_.dim == 3))
+    throw std::invalid_argument(std::string("SolidSystem: ") + (three_d ? "a hexahedron" : "a quadrilateral") +
+                                " element on a " + std::to_string(mesh_.dim) + "D mesh");
+  element_ = kind;
+}
+
+void SolidSystem::initialise() {
   const int n = num_dofs();
+  if (mesh_.nodes.cols() != mesh_.dim)
+    throw std::invalid_argument("SolidSystem: the mesh's nodes need " + std::to_string(mesh_.dim) + " coordinates");
   if (static_cast<int>(fixed_.size()) != n)
     throw std::invalid_argument("SolidSystem: fixed flags must have one entry per dof");
   equation_.assign(n, -1);
@@ -64,35 +96,49 @@ SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> 
     if (!fixed_[i]) equation_[i] = static_cast<int>(free_dofs_.size()), free_dofs_.push_back(i);
 
   for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const auto X = cell_coordinates(c);
-    double area2 = 0;
-    for (int a = 0; a < 4; ++a) area2 += X(a, 0) * X((a + 1) % 4, 1) - X((a + 1) % 4, 0) * X(a, 1);
-    if (!(area2 > 0))
-      throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
+    if (static_cast<int>(mesh_.cells[c].size()) != mesh_.nodes_per_cell())
+      throw std::invalid_argument("cell " + std::to_string(c) + " has " + std::to_string(mesh_.cells[c].size()) +
+                                  " nodes, expected " + std::to_string(mesh_.nodes_per_cell()));
+    for (int node : mesh_.cells[c])
+      if (node < 0 || node >= mesh_.num_nodes())
+        throw std::invalid_argument("cell " + std::to_string(c) + " names node " + std::to_string(node) +
+                                    " of a mesh of " + std::to_string(mesh_.num_nodes()));
+    if (mesh_.dim == 2) {
+      const auto X = cell_coordinates(c);
+      double area2 = 0;
+      for (int a = 0; a < 4; ++a) area2 += X(a, 0) * X((a + 1) % 4, 1) - X((a + 1) % 4, 0) * X(a, 1);
+      if (!(area2 > 0))
+        throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
+    } else {
+      const auto X = cell_coordinates<Hex8>(c);
+      for (const auto& [xi, w] : Hex8::gauss())
+        if (!((X.transpose() * Hex8::derivatives(xi)).determinant() > 0))
+          throw std::invalid_argument("cell " + std::to_string(c) + " is inverted or degenerate (node order)");
+    }
   }
 
   build_pattern({});
 }
 
 void SolidSystem::build_pattern(const std::vector<Eigen::Triplet<double>>& extra) {
-  const int n = num_dofs();
+  const int n = num_dofs(), dim = mesh_.dim, nd = dim * mesh_.nodes_per_cell(), nd2 = nd * nd;
   // Full pattern from the cell connectivity (and the extra entries).
   std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(64 * mesh_.cells.size() + extra.size());
+  trip.reserve(nd2 * mesh_.cells.size() + extra.size());
   for (const auto& cell : mesh_.cells)
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b) trip.emplace_back(2 * cell[a / 2] + a % 2, 2 * cell[b / 2] + b % 2, 0.0);
+    for (int a = 0; a < nd; ++a)
+      for (int b = 0; b < nd; ++b) trip.emplace_back(dim * cell[a / dim] + a % dim, dim * cell[b / dim] + b % dim, 0.0);
   for (const auto& e : extra) trip.emplace_back(e.row(), e.col(), 0.0);
   pattern_.resize(n, n);
   pattern_.setFromTriplets(trip.begin(), trip.end());
   pattern_.makeCompressed();
 
-  cell_positions_.resize(64 * mesh_.cells.size());
+  cell_positions_.resize(nd2 * mesh_.cells.size());
   for (std::size_t c = 0; c < mesh_.cells.size(); ++c) {
     const auto& cell = mesh_.cells[c];
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b)
-        cell_positions_[64 * c + 8 * a + b] = position(2 * cell[a / 2] + a % 2, 2 * cell[b / 2] + b % 2);
+    for (int a = 0; a < nd; ++a)
+      for (int b = 0; b < nd; ++b)
+        cell_positions_[nd2 * c + nd * a + b] = position(dim * cell[a / dim] + a % dim, dim * cell[b / dim] + b % dim);
   }
 
   // Reduced pattern and the value map.
@@ -115,10 +161,13 @@ void SolidSystem::build_pattern(const std::vector<Eigen::Triplet<double>>& extra
     }
 
   mass_ = pattern_;
-  for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const ElementMatrix Me = q4_mass(cell_coordinates(c), density_);
-    for (int k = 0; k < 64; ++k) mass_.valuePtr()[cell_positions_[64 * c + k]] += Me(k / 8, k % 8);
-  }
+  with_shape(dim, [&](auto shape) {
+    using Shape = decltype(shape);
+    for (int c = 0; c < mesh_.num_cells(); ++c) {
+      const auto Me = element_mass<Shape>(cell_coordinates<Shape>(c), density_);
+      for (int k = 0; k < nd2; ++k) mass_.valuePtr()[cell_positions_[nd2 * c + k]] += Me(k / nd, k % nd);
+    }
+  });
   damping_ = pattern_;
   solver_ = SparseDirectSolver(solver_.kind());  // a new pattern: analysed again on the next solve
 }
@@ -155,19 +204,8 @@ int SolidSystem::position(int row, int col) const {
   return static_cast<int>(it - pattern_.innerIndexPtr());
 }
 
-Eigen::Matrix<double, 4, 2> SolidSystem::cell_coordinates(int c) const {
-  Eigen::Matrix<double, 4, 2> X;
-  for (int a = 0; a < 4; ++a) X.row(a) = mesh_.nodes.row(mesh_.cells[c][a]);
-  return X;
-}
-
-Eigen::Matrix<double, 8, 1> SolidSystem::cell_values(int c, const Eigen::VectorXd& d) const {
-  Eigen::Matrix<double, 8, 1> u;
-  for (int a = 0; a < 4; ++a) u.segment<2>(2 * a) = d.segment<2>(2 * mesh_.cells[c][a]);
-  return u;
-}
-
-SparseMatrix SolidSystem::boundary_mass(const std::vector<std::array<int, 2>>& edges, double weight) const {
+SparseMatrix SolidSystem::boundary_mass(const std::vector<Facet>& edges, double weight) const {
+  if (mesh_.dim != 2) throw std::invalid_argument("boundary_mass: 2D meshes only");
   SparseMatrix C = pattern_;
   for (const auto& e : edges) {
     const Eigen::Matrix4d Me = edge_mass(mesh_.nodes.row(e[0]).transpose(), mesh_.nodes.row(e[1]).transpose(), weight);
@@ -183,17 +221,25 @@ void SolidSystem::set_damping(SparseMatrix damping) {
   damping_ = std::move(damping);
 }
 
-Eigen::VectorXd SolidSystem::body_force(const Eigen::Vector2d& b) const {
+Eigen::VectorXd SolidSystem::body_force(const Eigen::VectorXd& b) const {
+  if (b.size() != mesh_.dim) throw std::invalid_argument("body_force: one component per dimension");
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
-  for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const ElementVector fe = q4_body_force(cell_coordinates(c), b);
-    for (int a = 0; a < 4; ++a) f.segment<2>(2 * mesh_.cells[c][a]) += fe.segment<2>(2 * a);
-  }
+  with_shape(mesh_.dim, [&](auto shape) {
+    using Shape = decltype(shape);
+    constexpr int dim = Shape::dim;
+    const Eigen::Matrix<double, dim, 1> bd = b;
+    for (int c = 0; c < mesh_.num_cells(); ++c) {
+      const auto fe = element_body_force<Shape>(cell_coordinates<Shape>(c), bd);
+      for (int a = 0; a < Shape::nodes; ++a)
+        f.segment<dim>(dim * mesh_.cells[c][a]) += fe.template segment<dim>(dim * a);
+    }
+  });
   return f;
 }
 
 Eigen::VectorXd SolidSystem::body_force(const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& b,
                                         int gauss) const {
+  if (mesh_.dim != 2) throw std::invalid_argument("body_force(function): 2D meshes only");
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
   const auto rule = gauss_rule_2d(gauss);
   for (int c = 0; c < mesh_.num_cells(); ++c) {
@@ -208,19 +254,31 @@ Eigen::VectorXd SolidSystem::body_force(const std::function<Eigen::Vector2d(cons
   return f;
 }
 
-ElementState SolidSystem::cell_state(int c, const Eigen::VectorXd& d, bool with_tangent) const {
-  if (element_ == ElementKind::Q4Eas)
-    return q4_eas_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
-  return q4_internal_force(cell_coordinates(c), cell_values(c, d), *material_, with_tangent);
+template <class Shape>
+ElementStateT<Shape> SolidSystem::cell_state(int c, const Eigen::VectorXd& d, bool with_tangent) const {
+  const auto& law = [this]() -> const MaterialLaw<Shape::dim>& {
+    if constexpr (Shape::dim == 2)
+      return *material_;
+    else
+      return *material3_;
+  }();
+  if (is_enhanced(element_))
+    return eas_internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
+  return solid::internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
 }
 
 Eigen::VectorXd SolidSystem::internal_force(const Eigen::VectorXd& d) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
-  for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const ElementState s = cell_state(c, d, false);
-    if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
-    for (int a = 0; a < 4; ++a) f.segment<2>(2 * mesh_.cells[c][a]) += s.internal_force.segment<2>(2 * a);
-  }
+  with_shape(mesh_.dim, [&](auto shape) {
+    using Shape = decltype(shape);
+    constexpr int dim = Shape::dim;
+    for (int c = 0; c < mesh_.num_cells(); ++c) {
+      const ElementStateT<Shape> s = cell_state<Shape>(c, d, false);
+      if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
+      for (int a = 0; a < Shape::nodes; ++a)
+        f.segment<dim>(dim * mesh_.cells[c][a]) += s.internal_force.template segment<dim>(dim * a);
+    }
+  });
   return f;
 }
 
@@ -248,16 +306,21 @@ void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ex
   std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
   Eigen::VectorXd r = -f_ext;
   double* values = K.valuePtr();
-  for (int c = 0; c < mesh_.num_cells(); ++c) {
-    const ElementState s = cell_state(c, d, true);
-    if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
-    for (int a = 0; a < 4; ++a) r.segment<2>(2 * mesh_.cells[c][a]) += s.internal_force.segment<2>(2 * a);
-    const int* pos = &cell_positions_[64 * c];
-    for (int k = 0; k < 64; ++k) {
-      const int red = full_to_reduced_[pos[k]];
-      if (red >= 0) values[red] += s.tangent(k / 8, k % 8);
+  with_shape(mesh_.dim, [&](auto shape) {
+    using Shape = decltype(shape);
+    constexpr int dim = Shape::dim, nd = ElementTraits<Shape>::dofs;
+    for (int c = 0; c < mesh_.num_cells(); ++c) {
+      const ElementStateT<Shape> s = cell_state<Shape>(c, d, true);
+      if (!(s.min_det_F > 0)) throw InvertedElement(c, s.min_det_F);
+      for (int a = 0; a < Shape::nodes; ++a)
+        r.segment<dim>(dim * mesh_.cells[c][a]) += s.internal_force.template segment<dim>(dim * a);
+      const int* pos = &cell_positions_[nd * nd * c];
+      for (int k = 0; k < nd * nd; ++k) {
+        const int red = full_to_reduced_[pos[k]];
+        if (red >= 0) values[red] += s.tangent(k / nd, k % nd);
+      }
     }
-  }
+  });
   auto add_scaled = [&](const SparseMatrix& A, double coef) {
     if (coef == 0) return;
     for (Eigen::Index i = 0; i < A.nonZeros(); ++i)

@@ -15,7 +15,7 @@
 
 namespace fsi {
 
-enum class VtkCellType : int { Vertex = 1, Line = 3, Triangle = 5, Quad = 9 };
+enum class VtkCellType : int { Vertex = 1, Line = 3, Triangle = 5, Quad = 9, Hexahedron = 12 };
 
 struct VtkGrid {
   Eigen::MatrixXd points;                             // n x 2 or n x 3

@@ -1,5 +1,6 @@
 #pragma once
-// FemSolid: the finite-strain Q4 solid as an fsi::SolidModel.
+// FemSolid: the finite-strain solid as an fsi::SolidModel, in 2D (plane strain Q4) or 3D
+// (Hex8), the dimension taken from its mesh.
 //
 // Call order (the contract of solver_model.hpp):
 //   configure(section, setup) -> interface() -> { solve_step(info, F) ... accept_step(info) } -> write_output(info)
@@ -32,9 +33,9 @@ enum class TimeScheme { Static, Bdf1, Bdf2, Newmark };
 
 struct Probe {
   std::string name;
-  Eigen::Vector2d point;
+  Eigen::VectorXd point;
   int cell = -1;
-  Eigen::Vector2d xi;  // natural coordinates in `cell`
+  Eigen::VectorXd xi;  // natural coordinates in `cell`
 };
 
 // The keys of `solid.model: fem` (fem_solid_keys.cpp).
@@ -64,7 +65,8 @@ class FemSolid : public fsi::SolidModel {
   const Eigen::VectorXd& displacement() const { return d_; }  // last solve (trial) state
   const Eigen::VectorXd& velocity() const { return v_; }
   TimeScheme scheme() const { return scheme_; }
-  Eigen::Vector2d probe_displacement(const Probe& p, const Eigen::VectorXd& d) const;
+  Eigen::VectorXd probe_displacement(const Probe& p, const Eigen::VectorXd& d) const;  // dim components
+  int dim() const { return mesh_.dim; }
   const std::vector<Probe>& probes() const { return probes_; }
   int last_newton_iterations() const { return last_iterations_; }
 

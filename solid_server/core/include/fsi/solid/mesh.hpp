@@ -1,5 +1,7 @@
 #pragma once
-// Solid meshes: Q4 cells and named edge sets (for clamps, interfaces and loads).
+// Solid meshes of either dimension: Q4 cells in 2D, Hex8 cells in 3D, and named facet sets
+// (boundary edges in 2D, boundary quadrilaterals in 3D) for clamps, supports, interfaces
+// and loads.
 #include <Eigen/Core>
 #include <array>
 #include <map>
@@ -12,29 +14,39 @@ struct GmshMesh;
 
 namespace fsi::solid {
 
+using Facet = std::vector<int>;  // 2 nodes (2D edge) or 4 nodes (3D quadrilateral face)
+
 struct SolidMesh {
-  Eigen::MatrixX2d nodes;                                            // reference coordinates
-  std::vector<std::array<int, 4>> cells;                             // counter-clockwise Q4
-  std::map<std::string, std::vector<std::array<int, 2>>> edge_sets;  // boundary edges by name
+  int dim = 2;                                           // 2: plane strain Q4; 3: Hex8
+  Eigen::MatrixXd nodes;                                 // reference coordinates, n x dim
+  std::vector<std::vector<int>> cells;                   // counter-clockwise Q4, or Hex8 (element.hpp's order)
+  std::map<std::string, std::vector<Facet>> facet_sets;  // boundary facets by name
 
   int num_nodes() const { return static_cast<int>(nodes.rows()); }
   int num_cells() const { return static_cast<int>(cells.size()); }
-  // Edges of the named sets (throws std::invalid_argument listing the known names).
-  std::vector<std::array<int, 2>> edges(const std::vector<std::string>& names) const;
+  int nodes_per_cell() const { return dim == 2 ? 4 : 8; }
+  // Facets of the named sets (throws std::invalid_argument listing the known names).
+  std::vector<Facet> facets(const std::vector<std::string>& names) const;
   // Unique node ids of the named sets, in order of first appearance.
-  std::vector<int> edge_nodes(const std::vector<std::string>& names) const;
-  std::vector<std::string> edge_set_names() const;
+  std::vector<int> facet_nodes(const std::vector<std::string>& names) const;
+  std::vector<std::string> facet_set_names() const;
 };
 
 // Structured nx x ny Q4 mesh of [x0, x0+lx] x [y0, y0+ly]; edge sets "left", "right",
 // "bottom", "top". Node (i, j) has id j * (nx + 1) + i.
 SolidMesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int ny);
 
+// Structured nx x ny x nz Hex8 mesh of the box origin + [0, size]; face sets "left" (x min),
+// "right" (x max), "bottom" (y min), "top" (y max), "back" (z min), "front" (z max), each
+// face's nodes counter-clockwise seen from outside. Node (i, j, k) has id
+// (k * (ny + 1) + j) * (nx + 1) + i.
+SolidMesh box_mesh(const Eigen::Vector3d& origin, const Eigen::Vector3d& size, int nx, int ny, int nz);
+
 // Moves interior nodes of a mesh by a smooth-free random-like but deterministic
 // perturbation of up to `fraction` of the local spacing (for patch tests).
 void distort_interior(SolidMesh& mesh, double fraction, unsigned seed = 1);
 
-// Converts a gmsh mesh: every 2D group of quad4 cells (or only `domain` when non-empty)
+// Converts a gmsh mesh (2D): every 2D group of quad4 cells (or only `domain` when non-empty)
 // becomes the cells, every 1D group of 2-node lines an edge set of the same name. Unused
 // nodes are dropped; clockwise cells are reordered. Throws std::invalid_argument on
 // unsupported cell types.

@@ -7,6 +7,8 @@
 //
 // Usage:
 //   SolidSystem sys(mesh, material, density, fixed);   // fixed: one flag per dof
+// One code for 2D (Q4, plane strain) and 3D (Hex8): the mesh's dimension picks the element
+// shape, and the 3D constructor takes the 3D material law.
 //   sys.set_damping(sys.boundary_mass(edges, gamma));   // optional (Algorithm 2)
 //   NewtonReport r = sys.solve(d, f_ext, terms, options);
 // The sparsity pattern is analysed once (first solve); each Newton iteration
@@ -77,21 +79,28 @@ struct InvertedElement : std::runtime_error {
 
 class SolidSystem {
  public:
+  // A 2D mesh with a plane strain law.
   SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material> material, double density,
               std::vector<char> fixed_dofs, LinearSolverKind solver = LinearSolverKind::Cholmod);
+  // A 3D mesh with a 3D law.
+  SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material3> material, double density,
+              std::vector<char> fixed_dofs, LinearSolverKind solver = LinearSolverKind::Cholmod);
 
-  int num_dofs() const { return 2 * mesh_.num_nodes(); }
+  int dim() const { return mesh_.dim; }
+  int num_dofs() const { return mesh_.dim * mesh_.num_nodes(); }
   int num_free() const { return static_cast<int>(free_dofs_.size()); }
   const SolidMesh& mesh() const { return mesh_; }
-  const Material& material() const { return *material_; }
+  const Material& material() const { return *material_; }     // 2D
+  const Material3& material3() const { return *material3_; }  // 3D
   const std::vector<char>& fixed() const { return fixed_; }
 
   const SparseMatrix& mass() const { return mass_; }  // full, consistent
-  // Q4 (default) or Q4 with enhanced assumed strains, for every cell.
-  void set_element(ElementKind kind) { element_ = kind; }
+  // Q4 (2D default) or Q4 with enhanced assumed strains, for every cell; Hex8 (3D default) or
+  // Hex8 with enhanced assumed strains. Throws std::invalid_argument for the other dimension's.
+  void set_element(ElementKind kind);
   ElementKind element() const { return element_; }
-  // weight * int N^T N ds on the given edges (reference configuration), full size.
-  SparseMatrix boundary_mass(const std::vector<std::array<int, 2>>& edges, double weight) const;
+  // weight * int N^T N ds on the given edges (reference configuration), full size (2D).
+  SparseMatrix boundary_mass(const std::vector<Facet>& edges, double weight) const;
   void set_damping(SparseMatrix damping);  // C in R(d); pattern must fit the mesh's
   // C from entries (global dofs; duplicates add up). Entries outside the mesh's pattern (an
   // interface mass that couples nodes of different cells) extend the pattern once; the
@@ -99,7 +108,7 @@ class SolidSystem {
   void set_damping_entries(const std::vector<Eigen::Triplet<double>>& entries);
   const SparseMatrix& damping() const { return damping_; }
 
-  Eigen::VectorXd body_force(const Eigen::Vector2d& force_per_volume) const;
+  Eigen::VectorXd body_force(const Eigen::VectorXd& force_per_volume) const;  // dim components
   Eigen::VectorXd body_force(const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& f, int gauss = 3) const;
 
   // Internal force F_int(d) (full size). Throws InvertedElement.
@@ -122,8 +131,20 @@ class SolidSystem {
   SparseDirectSolver& linear_solver() { return solver_; }
   int equation(int dof) const { return equation_[dof]; }
 
-  Eigen::Matrix<double, 4, 2> cell_coordinates(int cell) const;
-  Eigen::Matrix<double, 8, 1> cell_values(int cell, const Eigen::VectorXd& d) const;
+  // A cell's reference coordinates and displacement dofs (Shape: Quad4 on 2D meshes, Hex8 on 3D).
+  template <class Shape = Quad4>
+  typename ElementTraits<Shape>::Coords cell_coordinates(int cell) const {
+    typename ElementTraits<Shape>::Coords X;
+    for (int a = 0; a < Shape::nodes; ++a) X.row(a) = mesh_.nodes.row(mesh_.cells[cell][a]);
+    return X;
+  }
+  template <class Shape = Quad4>
+  typename ElementTraits<Shape>::Vector cell_values(int cell, const Eigen::VectorXd& d) const {
+    typename ElementTraits<Shape>::Vector u;
+    for (int a = 0; a < Shape::nodes; ++a)
+      u.template segment<Shape::dim>(Shape::dim * a) = d.segment<Shape::dim>(Shape::dim * mesh_.cells[cell][a]);
+    return u;
+  }
 
  private:
   int position(int row, int col) const;       // value index in the full pattern (throws outside it)
@@ -132,7 +153,8 @@ class SolidSystem {
   // plus `extra` (global dof pairs).
   void build_pattern(const std::vector<Eigen::Triplet<double>>& extra);
   SolidMesh mesh_;
-  std::shared_ptr<const Material> material_;
+  std::shared_ptr<const Material> material_;    // 2D meshes
+  std::shared_ptr<const Material3> material3_;  // 3D meshes
   double density_;
   std::vector<char> fixed_;
   std::vector<int> equation_;         // dof -> free equation or -1
@@ -141,10 +163,12 @@ class SolidSystem {
   SparseMatrix mass_, damping_;       // full, on pattern_
   SparseMatrix reduced_pattern_;      // free x free
   std::vector<int> full_to_reduced_;  // value index map, -1 for fixed rows/cols
-  std::vector<int> cell_positions_;   // 64 per cell: full value index
+  std::vector<int> cell_positions_;   // (dofs per cell)^2 per cell: full value index
   SparseDirectSolver solver_;
   ElementKind element_ = ElementKind::Q4;
-  ElementState cell_state(int cell, const Eigen::VectorXd& d, bool with_tangent) const;
+  template <class Shape>
+  ElementStateT<Shape> cell_state(int cell, const Eigen::VectorXd& d, bool with_tangent) const;
+  void initialise();  // checks the cells, numbers the free dofs, builds the pattern
 };
 
 }  // namespace fsi::solid
