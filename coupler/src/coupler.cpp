@@ -199,6 +199,8 @@ struct Coupler::Run {
         gamma(c.settings_.nitsche_penalty),
         implicit(c.settings_.algorithm == Algorithm::ImplicitSolidVelocity),
         ns(static_cast<Eigen::Index>(c.solid_interface_.nodes())),
+        dim(c.solid_interface_.dimension),
+        nv(static_cast<Eigen::Index>(c.solid_interface_.values())),
         vtk_dir(c.out_dir_ / "vtk"),
         checkpoints(time.checkpoint_every > 0),
         start(start_time),
@@ -210,9 +212,8 @@ struct Coupler::Run {
     if (time.output_every > 0) interface_output.emplace(vtk_dir, c.solid_interface_, fluid_interface, time.vtk_format);
     const InterfaceMeshData& si = c.solid_interface_;
     const Eigen::VectorXd d_s =
-        si.initial_displacement.size() == 2 * ns ? si.initial_displacement : Eigen::VectorXd::Zero(2 * ns);
-    const Eigen::VectorXd v_s =
-        si.initial_velocity.size() == 2 * ns ? si.initial_velocity : Eigen::VectorXd::Zero(2 * ns);
+        si.initial_displacement.size() == nv ? si.initial_displacement : Eigen::VectorXd::Zero(nv);
+    const Eigen::VectorXd v_s = si.initial_velocity.size() == nv ? si.initial_velocity : Eigen::VectorXd::Zero(nv);
     state.v_s_prev = v_s;
     state.d_s_prev = d_s;
     state.d_f_prev = c.map_.to_fluid(d_s);
@@ -224,6 +225,8 @@ struct Coupler::Run {
   const double gamma;
   const bool implicit;
   const Eigen::Index ns;  // solid interface nodes
+  const int dim;          // values per interface node (2 or 3)
+  const Eigen::Index nv;  // values of a solid interface vector, dim * ns
   const std::filesystem::path vtk_dir;
   const bool checkpoints;
   const double start;  // wall clock at run()'s start
@@ -354,7 +357,11 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   fluid_interface = fluid_.interface();
   {
     Timer t(times_.coupler);
-    map_ = InterfaceMap(solid_interface_, fluid_interface, settings_.mapping);
+    try {
+      map_ = InterfaceMap(solid_interface_, fluid_interface, settings_.mapping);
+    } catch (const std::invalid_argument& e) {
+      throw Stop{"failed", fmt::format("solid '{}' and fluid '{}': {}", solid_.name(), fluid_.name(), e.what())};
+    }
   }
   return time;
 }
@@ -395,7 +402,7 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
       if (!ok) log->warn("time.output_every: the {} '{}' cannot write output (supports_output is false)", side, who);
   // Point interfaces: both sides' measures (int N^T N) should agree, or the Robin terms
   // weigh the two sides differently (in effect a damping of the wrong size or sign).
-  if (solid_interface_.segments.empty() && fluid_interface.segments.empty() &&
+  if (solid_interface_.points_only() && fluid_interface.points_only() &&
       solid_interface_.lumped_measure.size() == fluid_interface.lumped_measure.size()) {
     const double a = solid_interface_.lumped_measure.sum(), b = fluid_interface.lumped_measure.sum();
     if (std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b)))
@@ -629,17 +636,17 @@ void Coupler::load_restart(Run& r) {
 
 void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   State& st = r.state;
-  const Eigen::Index ns = r.ns;
+  const Eigen::Index nv = r.nv;
   const std::string dir = r.restart->dir.string();
-  st.force_n = c.vector("force_n", 2 * ns);
-  st.force_nm1 = c.vector("force_nm1", 2 * ns);
+  st.force_n = c.vector("force_n", nv);
+  st.force_nm1 = c.vector("force_nm1", nv);
   // Before the predictors' longer history: F_n and F_{n-1}.
-  st.force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", 2 * ns) : st.force_nm1;
-  st.force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", 2 * ns) : st.force_nm2;
+  st.force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", nv) : st.force_nm1;
+  st.force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", nv) : st.force_nm2;
   st.forces_known = c.has("forces_known") ? static_cast<int>(c.integer("forces_known")) : 2;
-  st.d_s_prev = c.vector("d_s_prev", 2 * ns);
+  st.d_s_prev = c.vector("d_s_prev", nv);
   st.d_f_prev = c.vector("d_f_prev", st.d_f_prev.size());
-  if (c.has("v_s_prev")) st.v_s_prev = c.vector("v_s_prev", 2 * ns);
+  if (c.has("v_s_prev")) st.v_s_prev = c.vector("v_s_prev", nv);
   if (c.has("work_uncancelled")) st.work_uncancelled = c.real("work_uncancelled");
   if (c.has("mapped_mass.values")) {
     const Eigen::VectorXd rows = c.vector("mapped_mass.rows"), cols = c.vector("mapped_mass.cols"),
@@ -1133,10 +1140,18 @@ void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::strin
   row["coupling.power_fluid"] = -last.traction.dot(dd) / r.time.dt;
   row["coupling.power_uncancelled"] = uncancelled / r.time.dt;
   row["coupling.work_uncancelled"] = st.work_uncancelled;
-  Eigen::Vector2d total = Eigen::Vector2d::Zero();
-  for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<2>(2 * i);
-  row["coupling.solid_force_x"] = total(0);
-  row["coupling.solid_force_y"] = total(1);
+  if (r.dim == 2) {
+    Eigen::Vector2d total = Eigen::Vector2d::Zero();
+    for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<2>(2 * i);
+    row["coupling.solid_force_x"] = total(0);
+    row["coupling.solid_force_y"] = total(1);
+  } else {
+    Eigen::Vector3d total = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<3>(3 * i);
+    row["coupling.solid_force_x"] = total(0);
+    row["coupling.solid_force_y"] = total(1);
+    row["coupling.solid_force_z"] = total(2);
+  }
   st.d_s_prev = s.interface_displacement;
   st.v_s_prev = s.interface_velocity;
   st.d_f_prev = last.d_f;

@@ -18,21 +18,10 @@ namespace fsi::solid {
 
 namespace {
 
-// A vector key of the mesh's dimension (fem_solid_keys.cpp's vector_key): [x, y] or [x, y, z];
-// absent: zero.
+// A vector key of the mesh's dimension ([x, y] or [x, y, z], checked by the reader); absent: zero.
 Eigen::VectorXd vec(const schema::Reader& s, const std::string& key, int dim) {
   if (!s.has(key)) return Eigen::VectorXd::Zero(dim);
-  std::vector<double> v;
-  try {
-    v = s.section().get<std::vector<double>>(key);
-  } catch (const ConfigError&) {
-    s.fail(key, fmt::format("must be a list of {} numbers", dim));
-  }
-  if (static_cast<int>(v.size()) != dim)
-    s.fail(key, fmt::format("has {} components, the mesh is {}D: give {}", v.size(), dim,
-                            dim == 2 ? "[x, y]" : "[x, y, z]"));
-  for (double x : v)
-    if (!std::isfinite(x)) s.fail(key, "must be finite");
+  const std::vector<double> v = s.vector(key, dim);
   return Eigen::Map<const Eigen::VectorXd>(v.data(), dim);
 }
 
