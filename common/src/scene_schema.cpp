@@ -432,7 +432,8 @@ class Checker {
         return add(at, key, message);
       }
       case Type::Vector2:
-        if (!numbers(v, 2)) return type_error(k, v, key, at);
+        if (!numbers(v, 2) && !(k.size == 3 && numbers(v, 3)))
+          return type_error(k, v, key, at);  // count(3): [x, y] or [x, y, z]
         return;
       case Type::NumberOrVector2:
         if (!is_number(v) && !numbers(v, 2)) return type_error(k, v, key, at);
