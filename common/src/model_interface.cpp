@@ -11,9 +11,10 @@ std::vector<schema::Key> model_interface_keys() {
   return {
       integer("dimension", "2 or 3: the space of the interface (3 values per node in 3D)").def("2").ge(2).le(3),
       section("surface",
-              "3D only: the interface is a rigid flat plate in the plane z = 0, centred at the origin, instead "
-              "of a point; its area is the interface measure",
+              "3D only: the interface is a rigid flat plate parallel to the plane z = 0, instead of a point; "
+              "its area is the interface measure",
               {vector2("size", "edge lengths [a, b] along x and y").req().in_unit("m"),
+               vector("centre", "the plate's centre [x, y, z]").def("[0, 0, 0]").in_unit("m"),
                int_list("divisions", 2, "[n_x, n_y] cells").def("[1, 1]"),
                choice("faces", {"quad", "triangle"}, "cells as quadrilaterals or as two triangles each")
                    .def("quad")}),
@@ -31,7 +32,8 @@ ModelInterface read_model_interface(const schema::Reader& s, const std::string& 
     if (!(size[0] > 0 && size[1] > 0)) surface->fail("size", "edge lengths must be > 0");
     const auto divisions = surface->get<std::vector<int>>("divisions");
     if (divisions[0] < 1 || divisions[1] < 1) surface->fail("divisions", "must be >= 1 each");
-    out.mesh = rectangle_surface(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+    const auto c = surface->vector("centre", 3);
+    out.mesh = rectangle_surface(Eigen::Vector3d(c[0], c[1], c[2]), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
                                  size[0], size[1], divisions[0], divisions[1],
                                  surface->get<std::string>("faces") == "triangle");
     out.measure = size[0] * size[1];

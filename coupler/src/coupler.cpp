@@ -12,6 +12,7 @@
 #include <optional>
 #include <tuple>
 
+#include "fsi/common/interface_geometry.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/state.hpp"
@@ -391,6 +392,33 @@ void Coupler::automatic_robin(const TimeSettings& time) {
       mass_per_area, time.dt, settings_.nitsche_penalty, settings_.fluid_penalty);
 }
 
+// The gap between the two interfaces against the solid's median element size: meshes in
+// different frames, units or places map every fluid node onto the solid's nearest edge and run
+// on without an error, so a large gap is refused (coupling.interface_gap).
+void Coupler::check_gap(nlohmann::json& data, const InterfaceMeshData& fluid_interface) const {
+  const auto& solid = solid_interface_;
+  std::vector<double> sizes;
+  const Eigen::MatrixXd& x = solid.coordinates;
+  for (const auto& s : solid.segments) sizes.push_back((x.row(s[1]) - x.row(s[0])).norm());
+  for (const auto& f : solid.faces) sizes.push_back(std::sqrt(face_area(x, f)));
+  if (sizes.empty()) return;  // a point interface: no element size to measure the gap against
+  std::nth_element(sizes.begin(), sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2), sizes.end());
+  const double h = sizes[sizes.size() / 2];
+  const double ratio = h > 0 ? map_.max_gap() / h : 0;
+  data["interface"]["element_size"] = h;
+  data["interface"]["gap_ratio"] = ratio;
+  if (ratio <= settings_.gap_warn) return;
+  const std::string what = fmt::format(
+      "the fluid's interface lies up to {:.3g} m from the solid's ({:.0f} % of the solid interface's median element "
+      "size {:.3g} m): are the two meshes in the same frame and units, and is the solid where the fluid's mesh "
+      "expects it (its origin)?",
+      map_.max_gap(), 100 * ratio, h);
+  if (settings_.gap_refuse > 0 && ratio > settings_.gap_refuse)
+    throw Stop{"failed", what + fmt::format(" Refused above {:.0f} % (coupling.interface_gap.refuse)",
+                                            100 * settings_.gap_refuse)};
+  logger("coupler")->warn("{} (warned above {:.0f} %: coupling.interface_gap.warn)", what, 100 * settings_.gap_warn);
+}
+
 void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface) {
   auto log = logger("coupler");
   const double gamma = settings_.nitsche_penalty;
@@ -423,6 +451,7 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
               map_.support_radius() > 0 ? fmt::format(", support radius {:.4g} m", map_.support_radius()) : "",
               map_.condition_estimate());
   }
+  check_gap(data, fluid_interface);
   if (map_.conforming()) {
     data["interface"]["permutation_error"] = map_.permutation_error();
     log->info(

@@ -1,7 +1,7 @@
 #pragma once
 // The interface of the point models (solid.model: sdof, fluid.model: surrogate) in 2D or 3D:
-// one node at the origin with a lumped measure, or, in 3D, a rigid flat plate (a rectangle in
-// the plane z = 0, divided into quadrilaterals or triangles) that moves as one body. Its keys
+// one node at the origin with a lumped measure, or, in 3D, a rigid flat plate (a rectangle
+// parallel to the plane z = 0, divided into quadrilaterals or triangles) that moves as one body. Its keys
 // are shared by both models so that a scene describes the two sides the same way.
 #include <vector>
 
