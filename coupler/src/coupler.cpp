@@ -666,6 +666,7 @@ void Coupler::load_restart(Run& r) {
 void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   State& st = r.state;
   const Eigen::Index nv = r.nv;
+  const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
   const std::string dir = r.restart->dir.string();
   st.force_n = c.vector("force_n", nv);
   st.force_nm1 = c.vector("force_nm1", nv);
