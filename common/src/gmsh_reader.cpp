@@ -1,4 +1,4 @@
-// gmsh ASCII reader: MSH 2.2 and MSH 4.1, physical groups of dimension 1 and 2.
+// gmsh ASCII reader: MSH 2.2 and MSH 4.1, physical groups of dimension 1, 2 and 3 (tetrahedra).
 //
 // Every element that carries a physical tag goes into the group (dimension, tag); node
 // indices are renumbered 0..n-1 in the order the nodes appear in the file. Errors name the
@@ -39,6 +39,10 @@ int nodes_per_element(int type) {
       return 1;  // point
     case 16:
       return 8;  // quad8
+    case 4:
+      return 4;  // tet4
+    case 11:
+      return 10;  // tet10
     default:
       return 0;
   }
@@ -127,14 +131,14 @@ struct RawElement {
 
 struct ReaderState {
   std::map<std::pair<int, int>, std::string> names;                  // (dim, tag) -> name
-  std::vector<std::pair<long, Eigen::Vector2d>> nodes;               // gmsh tag, position
+  std::vector<std::pair<long, Eigen::Vector3d>> nodes;               // gmsh tag, position
   std::map<std::pair<int, int>, std::vector<RawElement>> groups;     // (dim, physical) -> elements
   std::map<std::pair<int, int>, int> group_type;                     // first element type
   std::map<std::pair<int, int>, std::vector<int>> entity_physicals;  // 4.1: (dim, entity) -> physicals
 };
 
 void add_element(LineReader& reader, ReaderState& state, int dim, int physical, int type, std::vector<long> nodes) {
-  if (dim < 1 || dim > 2 || physical == 0) return;
+  if (dim < 1 || dim > 3 || physical == 0) return;
   auto key = std::make_pair(dim, physical);
   auto [it, inserted] = state.group_type.emplace(key, type);
   if (!inserted && it->second != type)
@@ -166,7 +170,7 @@ void read_nodes_v2(LineReader& reader, ReaderState& state) {
   state.nodes.reserve(static_cast<std::size_t>(std::min(n, kReserveAtMost)));
   for (long i = 0; i < n; ++i) {
     const auto v = parse_numbers<double>(reader, reader.require("a node"), 4, "'id x y z'");
-    state.nodes.push_back({whole<long>(reader, v[0], "a node id"), Eigen::Vector2d(v[1], v[2])});
+    state.nodes.push_back({whole<long>(reader, v[0], "a node id"), Eigen::Vector3d(v[1], v[2], v[3])});
   }
   if (reader.require("$EndNodes") != "$EndNodes") reader.fail("expected $EndNodes");
 }
@@ -180,7 +184,7 @@ void read_elements_v2(LineReader& reader, ReaderState& state) {
       reader.fail(fmt::format("element {} has {} tags: must be between 0 and the numbers on its line", v[0], v[2]));
     const int ntags = static_cast<int>(v[2]);
     const int nn = nodes_per_element(type);
-    if (dimension_of(type) > 2) continue;
+    if (dimension_of(type) > 2 && nn == 0) continue;  // other volume cells: not read
     if (nn == 0) reader.fail(fmt::format("unsupported gmsh element type {}", type));
     if (static_cast<int>(v.size()) != 3 + ntags + nn)
       reader.fail(fmt::format("element {} of type {} should have {} tags and {} nodes", v[0], type, ntags, nn));
@@ -222,7 +226,7 @@ void read_nodes_v4(LineReader& reader, ReaderState& state) {
       tags.push_back(parse_numbers<long>(reader, reader.require("a node tag"), 1, "a node tag")[0]);
     for (long i = 0; i < n; ++i) {
       const auto x = parse_numbers<double>(reader, reader.require("node coordinates"), parametric ? 4 : 3, "'x y z'");
-      state.nodes.push_back({tags[static_cast<std::size_t>(i)], Eigen::Vector2d(x[0], x[1])});
+      state.nodes.push_back({tags[static_cast<std::size_t>(i)], Eigen::Vector3d(x[0], x[1], x[2])});
     }
   }
   if (reader.require("$EndNodes") != "$EndNodes") reader.fail("expected $EndNodes");
@@ -241,7 +245,7 @@ void read_elements_v4(LineReader& reader, ReaderState& state) {
     const auto phys_it = state.entity_physicals.find({dim, entity});
     for (long i = 0; i < bh[3]; ++i) {
       const auto v = parse_numbers<long>(reader, reader.require("an element"), 1, "an element");
-      if (dim > 2) continue;
+      if (dim > 2 && nn == 0) continue;
       if (static_cast<int>(v.size()) != 1 + nn)
         reader.fail(fmt::format("element {} of type {} should have {} nodes", v[0], type, nn));
       if (phys_it == state.entity_physicals.end()) continue;
@@ -269,6 +273,12 @@ const GmshGroup& GmshMesh::group(const std::string& name) const {
   for (const auto& g : groups) known += (known.empty() ? "" : ", ") + g.name;
   throw std::runtime_error(fmt::format("mesh '{}' has no physical group '{}' (groups: {})", source.string(), name,
                                        known.empty() ? "none" : known));
+}
+
+bool GmshMesh::has_volume() const {
+  for (const auto& g : groups)
+    if (g.dimension == 3) return true;
+  return false;
 }
 
 bool GmshMesh::has_group(const std::string& name) const {
@@ -325,10 +335,12 @@ GmshMesh read_gmsh(std::istream& in, const std::filesystem::path& path) {
   GmshMesh mesh;
   mesh.source = path;
   mesh.nodes.resize(static_cast<Eigen::Index>(state.nodes.size()), 2);
+  mesh.z.resize(static_cast<Eigen::Index>(state.nodes.size()));
   std::unordered_map<long, int> index;
   index.reserve(state.nodes.size());
   for (std::size_t i = 0; i < state.nodes.size(); ++i) {
-    mesh.nodes.row(static_cast<Eigen::Index>(i)) = state.nodes[i].second.transpose();
+    mesh.nodes.row(static_cast<Eigen::Index>(i)) = state.nodes[i].second.head<2>().transpose();
+    mesh.z(static_cast<Eigen::Index>(i)) = state.nodes[i].second.z();
     index[state.nodes[i].first] = static_cast<int>(i);
   }
   for (const auto& [key, elements] : state.groups) {

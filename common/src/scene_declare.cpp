@@ -42,6 +42,8 @@ Key choice(std::string n, std::vector<std::string> values, std::string m) {
 }
 Key vector2(std::string n, std::string m) { return make(std::move(n), Type::Vector2, std::move(m)); }
 Key number_or_vector2(std::string n, std::string m) { return make(std::move(n), Type::NumberOrVector2, std::move(m)); }
+Key vector(std::string n, std::string m) { return make(std::move(n), Type::Vector, std::move(m)); }
+Key number_or_vector(std::string n, std::string m) { return make(std::move(n), Type::NumberOrVector, std::move(m)); }
 Key names(std::string n, std::string m) { return make(std::move(n), Type::Names, std::move(m)); }
 Key string_list(std::string n, std::string m) { return make(std::move(n), Type::StringList, std::move(m)); }
 Key int_list(std::string n, int size, std::string m) {

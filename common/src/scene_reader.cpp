@@ -1,7 +1,10 @@
 // Reading a scene section through its declaration (scene_reader.hpp).
 #include "fsi/common/scene_reader.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <cmath>
 
 namespace fsi::schema {
 
@@ -67,6 +70,34 @@ std::array<double, 2> Reader::vector2(const std::string& name) const {
   const auto v = declared_default<std::vector<double>>(k);
   if (v.size() != 2) detail::misuse(section_.full_key(name), "its declared default is not [x, y]");
   return {v[0], v[1]};
+}
+
+std::vector<double> Reader::vector(const std::string& name, int dim) const {
+  const Key& k = declared(name);
+  if (k.type != Type::Vector && k.type != Type::NumberOrVector)
+    detail::misuse(section_.full_key(name), "is read as a vector but not declared as one");
+  std::vector<double> v;
+  if (given(name)) {
+    if (section_.node_is_scalar(name)) {
+      if (k.type != Type::NumberOrVector) fail(name, fmt::format("must be a list of {} numbers", dim));
+      v = {section_.get<double>(name)};
+    } else {
+      v = section_.get<std::vector<double>>(name);
+      if (static_cast<int>(v.size()) != dim)
+        fail(name, fmt::format("has {} components, but the model is {}D: give {}", v.size(), dim,
+                               dim == 2 ? "[x, y]" : "[x, y, z]"));
+    }
+    for (double x : v)
+      if (!std::isfinite(x)) fail(name, "must be finite");
+  } else if (!k.computed_default && !k.default_value.empty() && k.default_value.front() != '[') {
+    v = {declared_default<double>(k)};
+  } else {
+    v = declared_default<std::vector<double>>(k);
+    if (static_cast<int>(v.size()) != dim)
+      detail::misuse(section_.full_key(name), "its declared default has the wrong number of components");
+  }
+  v.resize(static_cast<std::size_t>(dim), 0.0);
+  return v;
 }
 
 std::vector<std::string> Reader::names(const std::string& name) const {

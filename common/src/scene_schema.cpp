@@ -94,6 +94,10 @@ const char* type_text(Type t) {
       return "a list of 2 numbers [x, y]";
     case Type::NumberOrVector2:
       return "a number or a list [x, y]";
+    case Type::Vector:
+      return "a list [x, y] or [x, y, z]";
+    case Type::NumberOrVector:
+      return "a number or a list [x, y] or [x, y, z]";
     case Type::Names:
       return "a name or a list of names";
     case Type::StringList:
@@ -128,6 +132,10 @@ const char* short_type(Type t) {
       return "[x, y]";
     case Type::NumberOrVector2:
       return "number or [x, y]";
+    case Type::Vector:
+      return "[x, y] or [x, y, z]";
+    case Type::NumberOrVector:
+      return "number, [x, y] or [x, y, z]";
     case Type::Names:
       return "name or list of names";
     case Type::StringList:
@@ -424,10 +432,17 @@ class Checker {
         return add(at, key, message);
       }
       case Type::Vector2:
-        if (!numbers(v, 2)) return type_error(k, v, key, at);
+        if (!numbers(v, 2) && !(k.size == 3 && numbers(v, 3)))
+          return type_error(k, v, key, at);  // count(3): [x, y] or [x, y, z]
         return;
       case Type::NumberOrVector2:
         if (!is_number(v) && !numbers(v, 2)) return type_error(k, v, key, at);
+        return;
+      case Type::Vector:
+        if (!numbers(v, 2) && !numbers(v, 3)) return type_error(k, v, key, at);
+        return;
+      case Type::NumberOrVector:
+        if (!is_number(v) && !numbers(v, 2) && !numbers(v, 3)) return type_error(k, v, key, at);
         return;
       case Type::Names:
         if (!v.IsScalar() && !strings(v)) return type_error(k, v, key, at);

@@ -12,6 +12,7 @@
 #include <optional>
 #include <tuple>
 
+#include "fsi/common/interface_geometry.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/state.hpp"
@@ -199,6 +200,8 @@ struct Coupler::Run {
         gamma(c.settings_.nitsche_penalty),
         implicit(c.settings_.algorithm == Algorithm::ImplicitSolidVelocity),
         ns(static_cast<Eigen::Index>(c.solid_interface_.nodes())),
+        dim(c.solid_interface_.dimension),
+        nv(static_cast<Eigen::Index>(c.solid_interface_.values())),
         vtk_dir(c.out_dir_ / "vtk"),
         checkpoints(time.checkpoint_every > 0),
         start(start_time),
@@ -210,9 +213,8 @@ struct Coupler::Run {
     if (time.output_every > 0) interface_output.emplace(vtk_dir, c.solid_interface_, fluid_interface, time.vtk_format);
     const InterfaceMeshData& si = c.solid_interface_;
     const Eigen::VectorXd d_s =
-        si.initial_displacement.size() == 2 * ns ? si.initial_displacement : Eigen::VectorXd::Zero(2 * ns);
-    const Eigen::VectorXd v_s =
-        si.initial_velocity.size() == 2 * ns ? si.initial_velocity : Eigen::VectorXd::Zero(2 * ns);
+        si.initial_displacement.size() == nv ? si.initial_displacement : Eigen::VectorXd::Zero(nv);
+    const Eigen::VectorXd v_s = si.initial_velocity.size() == nv ? si.initial_velocity : Eigen::VectorXd::Zero(nv);
     state.v_s_prev = v_s;
     state.d_s_prev = d_s;
     state.d_f_prev = c.map_.to_fluid(d_s);
@@ -224,6 +226,8 @@ struct Coupler::Run {
   const double gamma;
   const bool implicit;
   const Eigen::Index ns;  // solid interface nodes
+  const int dim;          // values per interface node (2 or 3)
+  const Eigen::Index nv;  // values of a solid interface vector, dim * ns
   const std::filesystem::path vtk_dir;
   const bool checkpoints;
   const double start;  // wall clock at run()'s start
@@ -354,7 +358,11 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   fluid_interface = fluid_.interface();
   {
     Timer t(times_.coupler);
-    map_ = InterfaceMap(solid_interface_, fluid_interface, settings_.mapping);
+    try {
+      map_ = InterfaceMap(solid_interface_, fluid_interface, settings_.mapping);
+    } catch (const std::invalid_argument& e) {
+      throw Stop{"failed", fmt::format("solid '{}' and fluid '{}': {}", solid_.name(), fluid_.name(), e.what())};
+    }
   }
   return time;
 }
@@ -384,6 +392,33 @@ void Coupler::automatic_robin(const TimeSettings& time) {
       mass_per_area, time.dt, settings_.nitsche_penalty, settings_.fluid_penalty);
 }
 
+// The gap between the two interfaces against the solid's median element size: meshes in
+// different frames, units or places map every fluid node onto the solid's nearest edge and run
+// on without an error, so a large gap is refused (coupling.interface_gap).
+void Coupler::check_gap(nlohmann::json& data, const InterfaceMeshData& fluid_interface) const {
+  const auto& solid = solid_interface_;
+  std::vector<double> sizes;
+  const Eigen::MatrixXd& x = solid.coordinates;
+  for (const auto& s : solid.segments) sizes.push_back((x.row(s[1]) - x.row(s[0])).norm());
+  for (const auto& f : solid.faces) sizes.push_back(std::sqrt(face_area(x, f)));
+  if (sizes.empty()) return;  // a point interface: no element size to measure the gap against
+  std::nth_element(sizes.begin(), sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2), sizes.end());
+  const double h = sizes[sizes.size() / 2];
+  const double ratio = h > 0 ? map_.max_gap() / h : 0;
+  data["interface"]["element_size"] = h;
+  data["interface"]["gap_ratio"] = ratio;
+  if (ratio <= settings_.gap_warn) return;
+  const std::string what = fmt::format(
+      "the fluid's interface lies up to {:.3g} m from the solid's ({:.0f} % of the solid interface's median element "
+      "size {:.3g} m): are the two meshes in the same frame and units, and is the solid where the fluid's mesh "
+      "expects it (its origin)?",
+      map_.max_gap(), 100 * ratio, h);
+  if (settings_.gap_refuse > 0 && ratio > settings_.gap_refuse)
+    throw Stop{"failed", what + fmt::format(" Refused above {:.0f} % (coupling.interface_gap.refuse)",
+                                            100 * settings_.gap_refuse)};
+  logger("coupler")->warn("{} (warned above {:.0f} %: coupling.interface_gap.warn)", what, 100 * settings_.gap_warn);
+}
+
 void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface) {
   auto log = logger("coupler");
   const double gamma = settings_.nitsche_penalty;
@@ -395,7 +430,7 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
       if (!ok) log->warn("time.output_every: the {} '{}' cannot write output (supports_output is false)", side, who);
   // Point interfaces: both sides' measures (int N^T N) should agree, or the Robin terms
   // weigh the two sides differently (in effect a damping of the wrong size or sign).
-  if (solid_interface_.segments.empty() && fluid_interface.segments.empty() &&
+  if (solid_interface_.points_only() && fluid_interface.points_only() &&
       solid_interface_.lumped_measure.size() == fluid_interface.lumped_measure.size()) {
     const double a = solid_interface_.lumped_measure.sum(), b = fluid_interface.lumped_measure.sum();
     if (std::abs(a - b) > 1e-9 * std::max(std::abs(a), std::abs(b)))
@@ -416,6 +451,7 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
               map_.support_radius() > 0 ? fmt::format(", support radius {:.4g} m", map_.support_radius()) : "",
               map_.condition_estimate());
   }
+  check_gap(data, fluid_interface);
   if (map_.conforming()) {
     data["interface"]["permutation_error"] = map_.permutation_error();
     log->info(
@@ -629,17 +665,18 @@ void Coupler::load_restart(Run& r) {
 
 void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   State& st = r.state;
-  const Eigen::Index ns = r.ns;
+  const Eigen::Index nv = r.nv;
+  const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
   const std::string dir = r.restart->dir.string();
-  st.force_n = c.vector("force_n", 2 * ns);
-  st.force_nm1 = c.vector("force_nm1", 2 * ns);
+  st.force_n = c.vector("force_n", nv);
+  st.force_nm1 = c.vector("force_nm1", nv);
   // Before the predictors' longer history: F_n and F_{n-1}.
-  st.force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", 2 * ns) : st.force_nm1;
-  st.force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", 2 * ns) : st.force_nm2;
+  st.force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", nv) : st.force_nm1;
+  st.force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", nv) : st.force_nm2;
   st.forces_known = c.has("forces_known") ? static_cast<int>(c.integer("forces_known")) : 2;
-  st.d_s_prev = c.vector("d_s_prev", 2 * ns);
+  st.d_s_prev = c.vector("d_s_prev", nv);
   st.d_f_prev = c.vector("d_f_prev", st.d_f_prev.size());
-  if (c.has("v_s_prev")) st.v_s_prev = c.vector("v_s_prev", 2 * ns);
+  if (c.has("v_s_prev")) st.v_s_prev = c.vector("v_s_prev", nv);
   if (c.has("work_uncancelled")) st.work_uncancelled = c.real("work_uncancelled");
   if (c.has("mapped_mass.values")) {
     const Eigen::VectorXd rows = c.vector("mapped_mass.rows"), cols = c.vector("mapped_mass.cols"),
@@ -1133,10 +1170,18 @@ void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::strin
   row["coupling.power_fluid"] = -last.traction.dot(dd) / r.time.dt;
   row["coupling.power_uncancelled"] = uncancelled / r.time.dt;
   row["coupling.work_uncancelled"] = st.work_uncancelled;
-  Eigen::Vector2d total = Eigen::Vector2d::Zero();
-  for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<2>(2 * i);
-  row["coupling.solid_force_x"] = total(0);
-  row["coupling.solid_force_y"] = total(1);
+  if (r.dim == 2) {
+    Eigen::Vector2d total = Eigen::Vector2d::Zero();
+    for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<2>(2 * i);
+    row["coupling.solid_force_x"] = total(0);
+    row["coupling.solid_force_y"] = total(1);
+  } else {
+    Eigen::Vector3d total = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < r.ns; ++i) total -= last.traction.segment<3>(3 * i);
+    row["coupling.solid_force_x"] = total(0);
+    row["coupling.solid_force_y"] = total(1);
+    row["coupling.solid_force_z"] = total(2);
+  }
   st.d_s_prev = s.interface_displacement;
   st.v_s_prev = s.interface_velocity;
   st.d_f_prev = last.d_f;

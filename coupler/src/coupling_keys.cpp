@@ -155,6 +155,15 @@ schema::Key declare_coupling() {
                       number("factor", "growth over one window that ends the run as diverged").def("1000").gt(1),
                       integer("window", "steps per window").def("200").ge(1).in_unit("steps"),
                   }),
+          section("interface_gap",
+                  "the largest distance from a fluid interface node to the solid's interface, as a fraction "
+                  "of the solid interface's median element size (segment length; in 3D the square root of "
+                  "the face area): a gap this large means the two meshes are not in the same frame, units or "
+                  "place",
+                  {
+                      number("warn", "warn above this fraction").def("0.05").ge(0),
+                      number("refuse", "refuse to run above this fraction (0 = never refuse)").def("0.5").ge(0),
+                  }),
 
       });
   coupling.check = [](const Scene& scene) { (void)read_coupling(scene.section("coupling")); };

@@ -7,8 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <vector>
+
+#include "fsi/common/interface_geometry.hpp"
 
 namespace fsi::coupling {
 
@@ -32,6 +35,18 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
   if (ns == 0 || nf == 0)
     throw std::invalid_argument(
         fmt::format("interface mismatch: the solid has {} interface nodes, the fluid {}", ns, nf));
+  if (solid.dimension != fluid.dimension)
+    throw std::invalid_argument(fmt::format(
+        "interface mismatch: the solid's interface is {}D ({} values per node), the fluid's {}D: both servers must "
+        "describe the same space",
+        solid.dimension, solid.dimension, fluid.dimension, fluid.dimension));
+  dim_ = solid.dimension;
+  if (dim_ == 3) {
+    build_nearest_3d(solid, fluid);
+    if (kind_ != MappingKind::NearestSegment) build_rbf<3>(solid, fluid, mapping);
+    detect_conforming<3>(solid, fluid);
+    return;
+  }
   std::vector<Eigen::Triplet<double>> t, ts;
   for (Eigen::Index i = 0; i < nf; ++i) {
     const Eigen::Vector2d p = fluid.coordinates.row(i).transpose();
@@ -70,8 +85,68 @@ InterfaceMap::InterfaceMap(const InterfaceMeshData& solid, const InterfaceMeshDa
   hs_.setFromTriplets(ts.begin(), ts.end());
   hst_ = hs_.transpose();
 
-  if (kind_ != MappingKind::NearestSegment) build_rbf(solid, fluid, mapping);
-  detect_conforming(solid, fluid);
+  if (kind_ != MappingKind::NearestSegment) build_rbf<2>(solid, fluid, mapping);
+  detect_conforming<2>(solid, fluid);
+}
+
+// 3D: each fluid node takes the solid's interpolant at its closest point on the solid's
+// faces (nearest node for a point interface). Faces are visited in the order of the distance
+// to their bounding boxes, and the search stops when that bound exceeds the best distance.
+void InterfaceMap::build_nearest_3d(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
+  const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
+  std::vector<Eigen::Triplet<double>> ts;
+  if (solid.faces.empty()) {
+    for (Eigen::Index i = 0; i < nf; ++i) {
+      double best = std::numeric_limits<double>::infinity();
+      Eigen::Index k = 0;
+      for (Eigen::Index j = 0; j < ns; ++j) {
+        const double dist = (solid.coordinates.row(j) - fluid.coordinates.row(i)).norm();
+        if (dist < best) best = dist, k = j;
+      }
+      max_gap_ = std::max(max_gap_, best);
+      ts.emplace_back(i, k, 1.0);
+    }
+  } else {
+    const std::size_t nfaces = solid.faces.size();
+    std::vector<Eigen::Vector3d> lo(nfaces), hi(nfaces);
+    for (std::size_t f = 0; f < nfaces; ++f) {
+      lo[f] = hi[f] = solid.coordinates.row(solid.faces[f].nodes[0]).transpose();
+      for (int v : solid.faces[f].nodes) {
+        lo[f] = lo[f].cwiseMin(solid.coordinates.row(v).transpose());
+        hi[f] = hi[f].cwiseMax(solid.coordinates.row(v).transpose());
+      }
+      // curved quadratic faces bulge beyond their nodes' box by a fraction of its size
+      if (solid.faces[f].nodes.size() > 4) {
+        const Eigen::Vector3d pad = Eigen::Vector3d::Constant(0.25 * (hi[f] - lo[f]).norm());
+        lo[f] -= pad, hi[f] += pad;
+      }
+    }
+    std::vector<std::pair<double, std::size_t>> order(nfaces);
+    Eigen::VectorXd N;
+    Eigen::MatrixX2d dN;
+    for (Eigen::Index i = 0; i < nf; ++i) {
+      const Eigen::Vector3d p = fluid.coordinates.row(i).transpose();
+      for (std::size_t f = 0; f < nfaces; ++f) order[f] = {(p - p.cwiseMax(lo[f]).cwiseMin(hi[f])).norm(), f};
+      std::sort(order.begin(), order.end());
+      double best = std::numeric_limits<double>::infinity();
+      FaceProjection best_projection;
+      std::size_t best_face = 0;
+      for (const auto& [bound, f] : order) {
+        if (bound > best) break;
+        const FaceProjection q = project_on_face(solid.coordinates, solid.faces[f], p);
+        if (q.distance < best) best = q.distance, best_projection = q, best_face = f;
+      }
+      max_gap_ = std::max(max_gap_, best);
+      const InterfaceFace& face = solid.faces[best_face];
+      face_shape(static_cast<int>(face.nodes.size()), best_projection.xi, best_projection.eta, N, dN);
+      for (std::size_t a = 0; a < face.nodes.size(); ++a)
+        if (N[static_cast<Eigen::Index>(a)] != 0.0) ts.emplace_back(i, face.nodes[a], N[static_cast<Eigen::Index>(a)]);
+    }
+  }
+  Eigen::SparseMatrix<double> hs(nf, ns);
+  hs.setFromTriplets(ts.begin(), ts.end());  // duplicates (none expected) would add up
+  set_from_scalar(Eigen::MatrixXd(hs));
+  hs_dense_.resize(0, 0);  // the projection is sparse: keep the sparse products
 }
 
 void InterfaceMap::set_from_scalar(const Eigen::MatrixXd& hs) {
@@ -81,9 +156,9 @@ void InterfaceMap::set_from_scalar(const Eigen::MatrixXd& hs) {
       const double w = hs(i, j);
       if (w == 0.0) continue;
       ts.emplace_back(i, j, w);
-      for (int c = 0; c < 2; ++c) t.emplace_back(2 * i + c, 2 * j + c, w);
+      for (int c = 0; c < dim_; ++c) t.emplace_back(dim_ * i + c, dim_ * j + c, w);
     }
-  h_.resize(2 * hs.rows(), 2 * hs.cols());
+  h_.resize(dim_ * hs.rows(), dim_ * hs.cols());
   h_.setFromTriplets(t.begin(), t.end());
   ht_ = h_.transpose();
   hs_.resize(hs.rows(), hs.cols());
@@ -101,19 +176,23 @@ void InterfaceMap::set_from_scalar(const Eigen::MatrixXd& hs) {
 // Wendland's radius is scaled with them). The linear terms are taken along the principal
 // axes of the solid's nodes, and an axis without extent (nodes on a line) is dropped, as its
 // column of P would be zero and C singular.
+template <int D>
 void InterfaceMap::build_rbf(const InterfaceMeshData& solid, const InterfaceMeshData& fluid,
                              const MappingSettings& mapping) {
+  using Points = Eigen::Matrix<double, Eigen::Dynamic, D>;
+  using Row = Eigen::Matrix<double, 1, D>;
   const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
-  const Eigen::RowVector2d centre = solid.coordinates.colwise().mean();
-  const double diagonal = (solid.coordinates.colwise().maxCoeff() - solid.coordinates.colwise().minCoeff()).norm();
+  const Points xs = solid.coordinates, xf = fluid.coordinates;
+  const Row centre = xs.colwise().mean();
+  const double diagonal = (xs.colwise().maxCoeff() - xs.colwise().minCoeff()).norm();
   const double scale = diagonal > 0 ? diagonal : 1.0;
-  const Eigen::MatrixX2d ys = (solid.coordinates.rowwise() - centre) / scale;
-  const Eigen::MatrixX2d yf = (fluid.coordinates.rowwise() - centre) / scale;
+  const Points ys = (xs.rowwise() - centre) / scale;
+  const Points yf = (xf.rowwise() - centre) / scale;
 
   // Principal axes with an RMS extent above 1e-9 L.
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(ys), Eigen::ComputeFullV);
-  std::vector<Eigen::Vector2d> axes;
-  for (int k = 0; k < 2; ++k)
+  std::vector<Eigen::Matrix<double, D, 1>> axes;
+  for (int k = 0; k < D; ++k)
     if (svd.singularValues()[k] > 1e-9 * std::sqrt(static_cast<double>(ns))) axes.push_back(svd.matrixV().col(k));
   linear_terms_ = static_cast<int>(axes.size());
   const Eigen::Index np = 1 + linear_terms_, n = ns + np;
@@ -142,7 +221,7 @@ void InterfaceMap::build_rbf(const InterfaceMeshData& solid, const InterfaceMesh
     }
     return r > 0 ? r * r * std::log(r) : 0.0;
   };
-  auto poly = [&](const Eigen::RowVector2d& y, Eigen::Ref<Eigen::RowVectorXd> row) {
+  auto poly = [&](const Row& y, Eigen::Ref<Eigen::RowVectorXd> row) {
     row[0] = 1;
     for (int k = 0; k < linear_terms_; ++k) row[1 + k] = y.dot(axes[static_cast<std::size_t>(k)].transpose());
   };
@@ -177,10 +256,11 @@ void InterfaceMap::build_rbf(const InterfaceMeshData& solid, const InterfaceMesh
 // Conforming? The nearest solid node of every fluid node (detection only: H stays the
 // projection above, or the RBF interpolation, either of which is P to round-off for
 // coinciding nodes).
+template <int D>
 void InterfaceMap::detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
   const Eigen::Index ns = solid.coordinates.rows(), nf = fluid.coordinates.rows();
-  Eigen::Vector2d lo = solid.coordinates.colwise().minCoeff().transpose();
-  Eigen::Vector2d hi = solid.coordinates.colwise().maxCoeff().transpose();
+  Eigen::Matrix<double, D, 1> lo = solid.coordinates.colwise().minCoeff().transpose();
+  Eigen::Matrix<double, D, 1> hi = solid.coordinates.colwise().maxCoeff().transpose();
   lo = lo.cwiseMin(fluid.coordinates.colwise().minCoeff().transpose());
   hi = hi.cwiseMax(fluid.coordinates.colwise().maxCoeff().transpose());
   tolerance_ = 1e-9 * (hi - lo).norm();
@@ -227,39 +307,16 @@ NodalMatrix InterfaceMap::mass_to_solid(const NodalMatrix& fluid_mass) const {
   return m;
 }
 
-NodalMatrix nodal_interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement) {
-  const Eigen::Index n = solid.coordinates.rows();
-  std::vector<Eigen::Triplet<double>> t;
-  if (solid.segments.empty()) {
-    for (Eigen::Index i = 0; i < n; ++i) t.emplace_back(i, i, solid.lumped_measure[i]);
-  } else {
-    auto x = [&](int i) {
-      Eigen::Vector2d p = solid.coordinates.row(i).transpose();
-      if (displacement.size() == 2 * n) p += displacement.segment<2>(2 * i);
-      return p;
-    };
-    for (const auto& seg : solid.segments) {
-      const double len = (x(seg[1]) - x(seg[0])).norm();
-      t.emplace_back(seg[0], seg[0], len / 3);
-      t.emplace_back(seg[1], seg[1], len / 3);
-      t.emplace_back(seg[0], seg[1], len / 6);
-      t.emplace_back(seg[1], seg[0], len / 6);
-    }
-  }
-  NodalMatrix m(n, n);
-  m.setFromTriplets(t.begin(), t.end());
-  return m;
-}
-
 Eigen::SparseMatrix<double> interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement) {
-  // The nodal mass acting on both components: (M (x) I_2).
+  // The nodal mass acting on every component: (M (x) I_d).
   const NodalMatrix nodal = nodal_interface_mass(solid, displacement);
+  const int d = solid.dimension;
   std::vector<Eigen::Triplet<double>> t;
-  t.reserve(2 * static_cast<std::size_t>(nodal.nonZeros()));
+  t.reserve(static_cast<std::size_t>(d) * static_cast<std::size_t>(nodal.nonZeros()));
   for (int col = 0; col < nodal.outerSize(); ++col)
     for (NodalMatrix::InnerIterator it(nodal, col); it; ++it)
-      for (int c = 0; c < 2; ++c) t.emplace_back(2 * it.row() + c, 2 * it.col() + c, it.value());
-  Eigen::SparseMatrix<double> m(2 * nodal.rows(), 2 * nodal.cols());
+      for (int c = 0; c < d; ++c) t.emplace_back(d * it.row() + c, d * it.col() + c, it.value());
+  Eigen::SparseMatrix<double> m(d * nodal.rows(), d * nodal.cols());
   m.setFromTriplets(t.begin(), t.end());
   return m;
 }

@@ -9,10 +9,31 @@ namespace {
 VtkGrid grid_of(const InterfaceMeshData& mesh) {
   VtkGrid g;
   g.points = mesh.coordinates;
-  if (mesh.segments.empty()) {
+  if (mesh.points_only()) {
     for (int i = 0; i < static_cast<int>(mesh.nodes()); ++i) {
       g.cells.push_back({i});
       g.cell_types.push_back(VtkCellType::Vertex);
+    }
+  } else if (!mesh.faces.empty()) {
+    for (const auto& f : mesh.faces) {
+      g.cells.push_back(f.nodes);
+      switch (f.nodes.size()) {
+        case 3:
+          g.cell_types.push_back(VtkCellType::Triangle);
+          break;
+        case 4:
+          g.cell_types.push_back(VtkCellType::Quad);
+          break;
+        case 6:
+          g.cell_types.push_back(VtkCellType::QuadraticTriangle);
+          break;
+        case 8:
+          g.cell_types.push_back(VtkCellType::QuadraticQuad);
+          break;
+        default:
+          g.cell_types.push_back(VtkCellType::BiquadraticQuad);
+          break;
+      }
     }
   } else {
     for (const auto& s : mesh.segments) {
@@ -23,12 +44,12 @@ VtkGrid grid_of(const InterfaceMeshData& mesh) {
   return g;
 }
 
+// Interleaved values (d per node) as an n x d matrix.
 Eigen::MatrixXd nodal(const Eigen::VectorXd& v, Eigen::Index n, const char* name) {
-  if (v.size() != 2 * n)
+  if (n == 0 || v.size() % n != 0 || v.size() / n < 2 || v.size() / n > 3)
     throw std::invalid_argument(std::string("interface output: '") + name + "' has the wrong size");
-  Eigen::MatrixXd m(n, 2);
-  for (Eigen::Index i = 0; i < n; ++i) m.row(i) << v[2 * i], v[2 * i + 1];
-  return m;
+  const Eigen::Index d = v.size() / n;
+  return Eigen::Map<const Eigen::MatrixXd>(v.data(), d, n).transpose();
 }
 
 }  // namespace

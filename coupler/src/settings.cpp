@@ -150,6 +150,8 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   c.force_limit = s.get<double>("force_limit");
   c.growth_factor = s.child_or_defaults("growth").get<double>("factor");
   c.growth_window = s.child_or_defaults("growth").get<int>("window");
+  c.gap_warn = s.child_or_defaults("interface_gap").get<double>("warn");
+  c.gap_refuse = s.child_or_defaults("interface_gap").get<double>("refuse");
   return c;
 }
 

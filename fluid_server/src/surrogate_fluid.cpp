@@ -1,65 +1,67 @@
 #include "fsi/models/surrogate_fluid.hpp"
 
+#include "fsi/common/interface_geometry.hpp"
 #include "fsi/common/scene_reader.hpp"
 
 namespace fsi::models {
-namespace {
-Eigen::Vector2d vector2(const schema::Reader& r, const std::string& key) {
-  const auto v = r.vector2(key);
-  return {v[0], v[1]};
-}
-}  // namespace
 
 void SurrogateFluid::configure(const ConfigSection& section, const FluidSetup&) {
   const schema::Reader s(section, surrogate_fluid_keys());
-  force_ = vector2(s, "force");
+  interface_ = read_model_interface(s, "interface_measure");
+  const int dim = interface_.dimension();
+  const auto f = s.vector("force", dim);
+  force_ = Eigen::Map<const Eigen::VectorXd>(f.data(), dim);
   added_mass_ = s.get<double>("added_mass");
-  measure_ = s.get<double>("interface_measure");
+  const auto& mesh = interface_.mesh;
+  mass_ = nodal_interface_mass(mesh, Eigen::VectorXd());
+  weight_ = mesh.lumped_measure / mesh.lumped_measure.sum();
+  if (mesh.nodes() == 1) weight_.setOnes();
+  const Eigen::Index n = dim * static_cast<Eigen::Index>(mesh.nodes());
+  v_n_ = v_ = last_force_on_solid_ = Eigen::VectorXd::Zero(n);
 }
 
-InterfaceMeshData SurrogateFluid::interface() const {
-  InterfaceMeshData data;
-  data.node_ids = {0};
-  data.coordinates = Eigen::MatrixX2d::Zero(1, 2);
-  data.lumped_measure = Eigen::VectorXd::Constant(1, measure_);
-  return data;
-}
+InterfaceMeshData SurrogateFluid::interface() const { return interface_.mesh; }
 
-FluidLoads SurrogateFluid::loads(const Eigen::Vector2d& v, const Eigen::Vector2d& acceleration) {
-  last_force_on_solid_ = force_ - added_mass_ * acceleration;
+FluidLoads SurrogateFluid::loads(const Eigen::VectorXd& v, const Eigen::VectorXd& acceleration) {
+  const Eigen::Index d = interface_.dimension();
+  for (Eigen::Index i = 0; i < weight_.size(); ++i)
+    last_force_on_solid_.segment(d * i, d) = weight_[i] * (force_ - added_mass_ * acceleration.segment(d * i, d));
   FluidLoads out;
   out.traction_force = -last_force_on_solid_;
-  out.velocity_integral = measure_ * v;
-  out.interface_mass.resize(1, 1);
-  out.interface_mass.insert(0, 0) = measure_;
+  out.velocity_integral = weight_.size() == 1 ? Eigen::VectorXd(interface_.measure * v) : apply_nodal(mass_, v);
+  out.interface_mass = mass_;
   out.nonlinear_iterations = 1;
   return out;
 }
 
 FluidLoads SurrogateFluid::initial_loads(const Eigen::VectorXd&, const Eigen::VectorXd& v) {
-  v_n_ = v_ = v.head<2>();
-  return loads(v_, Eigen::Vector2d::Zero());
+  v_n_ = v_ = v;
+  return loads(v_, Eigen::VectorXd::Zero(v.size()));
 }
 
 FluidLoads SurrogateFluid::solve_step(const StepInfo& info, const Eigen::VectorXd&, const Eigen::VectorXd& v) {
-  v_ = v.head<2>();
+  v_ = v;
   return loads(v_, (v_ - v_n_) / info.dt);
 }
 
 std::map<std::string, double> SurrogateFluid::accept_step(const StepInfo&) {
   v_n_ = v_;
-  return {{"force_x", last_force_on_solid_[0]}, {"force_y", last_force_on_solid_[1]}};
+  const Eigen::VectorXd f = interface_.resultant(last_force_on_solid_);
+  std::map<std::string, double> probes{{"force_x", f[0]}, {"force_y", f[1]}};
+  if (f.size() == 3) probes["force_z"] = f[2];
+  return probes;
 }
 
 void SurrogateFluid::save_state(StateArchive& state) {
-  state.put("surrogate.v_n", Eigen::VectorXd(v_n_));
-  state.put("surrogate.v", Eigen::VectorXd(v_));
-  state.put("surrogate.force_on_solid", Eigen::VectorXd(last_force_on_solid_));
+  state.put("surrogate.v_n", v_n_);
+  state.put("surrogate.v", v_);
+  state.put("surrogate.force_on_solid", last_force_on_solid_);
 }
 
 void SurrogateFluid::load_state(const StateArchive& state) {
-  const Eigen::VectorXd v_n = state.vector("surrogate.v_n", 2), v = state.vector("surrogate.v", 2),
-                        f = state.vector("surrogate.force_on_solid", 2);
+  const Eigen::Index n = v_.size();
+  const Eigen::VectorXd v_n = state.vector("surrogate.v_n", n), v = state.vector("surrogate.v", n),
+                        f = state.vector("surrogate.force_on_solid", n);
   v_n_ = v_n;
   v_ = v;
   last_force_on_solid_ = f;

@@ -56,18 +56,24 @@ NodalMatrix nodal_from_proto(const fsi::v1::NodalMatrix& m, std::size_t n, const
 
 InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
   InterfaceMeshData data;
-  const int n = mesh.coordinates_size() / 2;
-  if (mesh.coordinates_size() % 2 != 0) throw std::invalid_argument("interface mesh: odd number of coordinates");
+  const unsigned dim_field = mesh.dimension();
+  if (dim_field != 0 && dim_field != 2 && dim_field != 3)
+    throw std::invalid_argument(fmt::format("interface mesh: dimension {} (must be 2 or 3; absent = 2)", dim_field));
+  const int d = dim_field == 3 ? 3 : 2;
+  data.dimension = d;
+  if (mesh.coordinates_size() % d != 0)
+    throw std::invalid_argument(fmt::format("interface mesh: {} coordinates is not a multiple of {} (dimension {})",
+                                            mesh.coordinates_size(), d, d));
+  const int n = mesh.coordinates_size() / d;
   if (n == 0) throw std::invalid_argument("interface mesh: no nodes (coordinates is empty)");
+  static const char* axis[] = {"x", "y", "z"};
   for (int i = 0; i < mesh.coordinates_size(); ++i)
     if (!std::isfinite(mesh.coordinates(i)))
       throw std::invalid_argument(
-          fmt::format("interface mesh: coordinate {} of node {} is not finite", i % 2 ? "y" : "x", i / 2));
-  data.coordinates.resize(n, 2);
-  for (int i = 0; i < n; ++i) {
-    data.coordinates(i, 0) = mesh.coordinates(2 * i);
-    data.coordinates(i, 1) = mesh.coordinates(2 * i + 1);
-  }
+          fmt::format("interface mesh: coordinate {} of node {} is not finite", axis[i % d], i / d));
+  data.coordinates.resize(n, d);
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < d; ++c) data.coordinates(i, c) = mesh.coordinates(d * i + c);
   data.node_ids.assign(mesh.node_ids().begin(), mesh.node_ids().end());
   if (data.node_ids.empty())
     for (int i = 0; i < n; ++i) data.node_ids.push_back(i);
@@ -79,6 +85,10 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
     const auto dup = std::adjacent_find(ids.begin(), ids.end());
     if (dup != ids.end()) throw std::invalid_argument(fmt::format("interface mesh: node id {} appears twice", *dup));
   }
+  if (d == 3 && mesh.segments_size() > 0)
+    throw std::invalid_argument("interface mesh: segments in a 3D interface (3D interfaces are described by faces)");
+  if (d == 2 && (mesh.faces_size() > 0 || mesh.face_sizes_size() > 0))
+    throw std::invalid_argument("interface mesh: faces in a 2D interface (set dimension: 3, or send segments)");
   if (mesh.segments_size() % 2 != 0) throw std::invalid_argument("interface mesh: odd number of segment indices");
   for (int s = 0; s < mesh.segments_size() / 2; ++s) {
     const int a = static_cast<int>(mesh.segments(2 * s)), b = static_cast<int>(mesh.segments(2 * s + 1));
@@ -88,9 +98,38 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
     if (a == b) throw std::invalid_argument(fmt::format("interface mesh: segment {} joins node {} to itself", s, a));
     data.segments.push_back({a, b});
   }
+  {
+    int offset = 0;
+    for (int f = 0; f < mesh.face_sizes_size(); ++f) {
+      const unsigned size = mesh.face_sizes(f);
+      if (size != 3 && size != 4 && size != 6 && size != 8 && size != 9)
+        throw std::invalid_argument(
+            fmt::format("interface mesh: face {} has {} nodes (3 or 6: triangle, 4, 8 or 9: quadrilateral)", f, size));
+      if (offset + static_cast<int>(size) > mesh.faces_size())
+        throw std::invalid_argument(fmt::format("interface mesh: face {} needs {} indices, {} are left in faces", f,
+                                                size, mesh.faces_size() - offset));
+      InterfaceFace face;
+      for (unsigned k = 0; k < size; ++k) {
+        const unsigned v = mesh.faces(offset + static_cast<int>(k));
+        if (v >= static_cast<unsigned>(n))
+          throw std::invalid_argument(fmt::format("interface mesh: face {} refers to node {} of {}", f, v, n));
+        face.nodes.push_back(static_cast<int>(v));
+      }
+      auto sorted = face.nodes;
+      std::sort(sorted.begin(), sorted.end());
+      if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
+        throw std::invalid_argument(fmt::format("interface mesh: face {} uses a node twice", f));
+      offset += static_cast<int>(size);
+      data.faces.push_back(std::move(face));
+    }
+    if (offset != mesh.faces_size())
+      throw std::invalid_argument(
+          fmt::format("interface mesh: face_sizes account for {} of {} face indices", offset, mesh.faces_size()));
+  }
   data.lumped_measure = to_eigen(mesh.lumped_measure());
-  if (data.segments.empty() && data.lumped_measure.size() != n && n > 0)
-    throw std::invalid_argument("interface mesh: a point interface needs one lumped_measure per node");
+  if (data.points_only() && data.lumped_measure.size() != n && n > 0)
+    throw std::invalid_argument(fmt::format("interface mesh: a point interface needs one lumped_measure per node{}",
+                                            d == 3 ? " (or faces)" : ""));
   if (data.lumped_measure.size() != 0 && data.lumped_measure.size() != n)
     throw std::invalid_argument(
         fmt::format("interface mesh: {} lumped_measure values for {} nodes", data.lumped_measure.size(), n));
@@ -109,26 +148,29 @@ InterfaceMeshData interface_from_proto(const fsi::v1::InterfaceMesh& mesh) {
   for (const auto& [what, v] :
        {std::pair<const char*, const Eigen::VectorXd*>{"initial_displacement", &data.initial_displacement},
         {"initial_velocity", &data.initial_velocity}}) {
-    if (v->size() != 0 && v->size() != 2 * n)
+    if (v->size() != 0 && v->size() != d * n)
       throw std::invalid_argument(
-          fmt::format("interface mesh: {} has {} values, expected 0 or {}", what, v->size(), 2 * n));
+          fmt::format("interface mesh: {} has {} values, expected 0 or {}", what, v->size(), d * n));
     for (Eigen::Index i = 0; i < v->size(); ++i)
       if (!std::isfinite((*v)[i]))
-        throw std::invalid_argument(fmt::format("interface mesh: {} of node {} is not finite", what, i / 2));
+        throw std::invalid_argument(fmt::format("interface mesh: {} of node {} is not finite", what, i / d));
   }
   return data;
 }
 
 void interface_to_proto(const InterfaceMeshData& data, fsi::v1::InterfaceMesh* mesh) {
   for (auto id : data.node_ids) mesh->add_node_ids(id);
-  for (Eigen::Index i = 0; i < data.coordinates.rows(); ++i) {
-    mesh->add_coordinates(data.coordinates(i, 0));
-    mesh->add_coordinates(data.coordinates(i, 1));
-  }
+  for (Eigen::Index i = 0; i < data.coordinates.rows(); ++i)
+    for (Eigen::Index c = 0; c < data.coordinates.cols(); ++c) mesh->add_coordinates(data.coordinates(i, c));
   for (const auto& s : data.segments) {
     mesh->add_segments(static_cast<unsigned>(s[0]));
     mesh->add_segments(static_cast<unsigned>(s[1]));
   }
+  for (const auto& f : data.faces) {
+    mesh->add_face_sizes(static_cast<unsigned>(f.nodes.size()));
+    for (int v : f.nodes) mesh->add_faces(static_cast<unsigned>(v));
+  }
+  if (data.dimension != 2) mesh->set_dimension(static_cast<unsigned>(data.dimension));  // 2D sends nothing new
   from_eigen(data.lumped_measure, mesh->mutable_lumped_measure());
   from_eigen(data.initial_displacement, mesh->mutable_initial_displacement());
   from_eigen(data.initial_velocity, mesh->mutable_initial_velocity());
@@ -230,15 +272,18 @@ InterfaceMeshData get_interface(ProtocolClient& client, std::uint32_t configured
   return data;
 }
 
-Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, std::size_t n, const ProtocolClient& client,
-                        const char* what) {
-  if (static_cast<std::size_t>(f.size()) != 2 * n)
-    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT, fmt::format("{} sent {} values for '{}', expected {}",
-                                                                    client.peer_name(), f.size(), what, 2 * n));
+Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, const InterfaceMeshData& mesh,
+                        const ProtocolClient& client, const char* what) {
+  const std::size_t expected = mesh.values();
+  if (static_cast<std::size_t>(f.size()) != expected)
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} sent {} values for '{}', expected {} ({} nodes x {})", client.peer_name(),
+                                  f.size(), what, expected, mesh.nodes(), mesh.dimension));
   Eigen::VectorXd v = to_eigen(f);
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
-      throw SolverError(fmt::format("{} sent a non-finite '{}' at node {}", client.peer_name(), what, i / 2));
+      throw SolverError(
+          fmt::format("{} sent a non-finite '{}' at node {}", client.peer_name(), what, i / mesh.dimension));
   return v;
 }
 
@@ -337,9 +382,8 @@ SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::Vecto
   expect(reply.has_solid_step(), *client_, "solve_step");
   SolidStepResult out;
   out.interface_displacement =
-      checked(reply.solid_step().interface_displacement(), interface_.nodes(), *client_, "interface_displacement");
-  out.interface_velocity =
-      checked(reply.solid_step().interface_velocity(), interface_.nodes(), *client_, "interface_velocity");
+      checked(reply.solid_step().interface_displacement(), interface_, *client_, "interface_displacement");
+  out.interface_velocity = checked(reply.solid_step().interface_velocity(), interface_, *client_, "interface_velocity");
   out.newton_iterations = static_cast<int>(reply.solid_step().newton_iterations());
   return out;
 }
@@ -372,11 +416,12 @@ void RemoteFluid::configure(const ConfigSection& section, const FluidSetup& setu
 }
 
 namespace {
-FluidLoads loads_from(const fsi::v1::Reply& reply, std::size_t n, const ProtocolClient& client) {
+FluidLoads loads_from(const fsi::v1::Reply& reply, const InterfaceMeshData& mesh, const ProtocolClient& client) {
   expect(reply.has_fluid_loads(), client, "a fluid solve");
   FluidLoads out;
-  out.traction_force = checked(reply.fluid_loads().traction_force(), n, client, "traction_force");
-  out.velocity_integral = checked(reply.fluid_loads().velocity_integral(), n, client, "velocity_integral");
+  const std::size_t n = mesh.nodes();
+  out.traction_force = checked(reply.fluid_loads().traction_force(), mesh, client, "traction_force");
+  out.velocity_integral = checked(reply.fluid_loads().velocity_integral(), mesh, client, "velocity_integral");
   out.nonlinear_iterations = static_cast<int>(reply.fluid_loads().nonlinear_iterations());
   if (reply.fluid_loads().has_interface_mass()) {
     try {
@@ -393,7 +438,7 @@ FluidLoads RemoteFluid::initial_loads(const Eigen::VectorXd& d, const Eigen::Vec
   fsi::v1::Request r;
   from_eigen(d, r.mutable_initial_loads()->mutable_interface_displacement());
   from_eigen(v, r.mutable_initial_loads()->mutable_interface_velocity());
-  return loads_from(client_->call(r), interface_.nodes(), *client_);
+  return loads_from(client_->call(r), interface_, *client_);
 }
 
 FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) {
@@ -405,7 +450,7 @@ FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& 
   s->set_iteration(static_cast<unsigned>(info.iteration));
   from_eigen(d, s->mutable_interface_displacement());
   from_eigen(v, s->mutable_interface_velocity());
-  return loads_from(step_call(*client_, r), interface_.nodes(), *client_);
+  return loads_from(step_call(*client_, r), interface_, *client_);
 }
 
 std::map<std::string, double> RemoteFluid::accept_step(const StepInfo& info) {

@@ -25,23 +25,30 @@ void set_error(fsi::v1::Reply& reply, fsi::v1::Error::Code code, const std::stri
 }
 
 // Checks a received vector: expected size and every entry finite.
-Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& field, std::size_t expected,
+const char* axis_name(int component) {
+  static const char* names[] = {"x", "y", "z"};
+  return names[component];
+}
+
+// Checks a received vector: `dim` values per interface node and every entry finite.
+Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& field, std::size_t nodes, int dim,
                                const char* name) {
+  const std::size_t expected = nodes * static_cast<std::size_t>(dim);
   if (static_cast<std::size_t>(field.size()) != expected)
     throw std::invalid_argument(
-        fmt::format("'{}' has {} values, expected {} (2 per interface node)", name, field.size(), expected));
+        fmt::format("'{}' has {} values, expected {} ({} per interface node)", name, field.size(), expected, dim));
   for (int i = 0; i < field.size(); ++i)
     if (!std::isfinite(field.Get(i)))
-      throw std::invalid_argument(fmt::format("'{}' value {} (node {}, component {}) is not finite: {}", name, i, i / 2,
-                                              i % 2 ? "y" : "x", field.Get(i)));
+      throw std::invalid_argument(fmt::format("'{}' value {} (node {}, component {}) is not finite: {}", name, i,
+                                              i / dim, axis_name(i % dim), field.Get(i)));
   return to_eigen(field);
 }
 
-void require_finite(const Eigen::VectorXd& v, const std::string& what) {
+void require_finite(const Eigen::VectorXd& v, int dim, const std::string& what) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
-      throw SolverError(
-          fmt::format("{} produced a non-finite value at node {} ({}): {}", what, i / 2, i % 2 ? "y" : "x", v[i]));
+      throw SolverError(fmt::format("{} produced a non-finite value at node {} ({}): {}", what, i / dim,
+                                    axis_name(static_cast<int>(i % dim)), v[i]));
 }
 
 Scene scene_from(const fsi::v1::Configure& c) {
@@ -221,6 +228,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       scene.check_all_used(section.path());
       model_ = std::move(model);
       interface_nodes_ = model_->interface().nodes();
+      dimension_ = model_->interface().dimension;
       dt_ = c.dt();
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
       break;
@@ -228,13 +236,14 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     case R::kSolveStep: {
       need_model("solve_step");
       const auto& s = request.solve_step();
-      const Eigen::VectorXd force = checked_vector(s.interface_force(), 2 * interface_nodes_, "interface_force");
+      const Eigen::VectorXd force =
+          checked_vector(s.interface_force(), interface_nodes_, dimension_, "interface_force");
       StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
       if (s.has_interface_mass())
         model_->set_interface_mass(nodal_from_proto(s.interface_mass(), interface_nodes_, "interface_mass"));
       const SolidStepResult result = model_->solve_step(info, force);
-      require_finite(result.interface_displacement, "solid step (displacement)");
-      require_finite(result.interface_velocity, "solid step (velocity)");
+      require_finite(result.interface_displacement, dimension_, "solid step (displacement)");
+      require_finite(result.interface_velocity, dimension_, "solid step (velocity)");
       auto* out = reply.mutable_solid_step();
       from_eigen(result.interface_displacement, out->mutable_interface_displacement());
       from_eigen(result.interface_velocity, out->mutable_interface_velocity());
@@ -258,8 +267,8 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     if (!model_) throw RemoteError(fsi::v1::Error::BAD_SEQUENCE, before_configure(what));
   };
   auto loads_reply = [&](const FluidLoads& loads) {
-    require_finite(loads.traction_force, "fluid step (traction force)");
-    require_finite(loads.velocity_integral, "fluid step (velocity integral)");
+    require_finite(loads.traction_force, dimension_, "fluid step (traction force)");
+    require_finite(loads.velocity_integral, dimension_, "fluid step (velocity integral)");
     auto* out = reply.mutable_fluid_loads();
     from_eigen(loads.traction_force, out->mutable_traction_force());
     from_eigen(loads.velocity_integral, out->mutable_velocity_integral());
@@ -299,6 +308,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       scene.check_all_used(section.path());
       model_ = std::move(model);
       interface_nodes_ = model_->interface().nodes();
+      dimension_ = model_->interface().dimension;
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
       break;
     }
@@ -306,8 +316,8 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       need_model("initial_loads");
       const auto& s = request.initial_loads();
       loads_reply(model_->initial_loads(
-          checked_vector(s.interface_displacement(), 2 * interface_nodes_, "interface_displacement"),
-          checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
+          checked_vector(s.interface_displacement(), interface_nodes_, dimension_, "interface_displacement"),
+          checked_vector(s.interface_velocity(), interface_nodes_, dimension_, "interface_velocity")));
       break;
     }
     case R::kSolveStep: {
@@ -315,8 +325,8 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       const auto& s = request.solve_step();
       StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
       loads_reply(model_->solve_step(
-          info, checked_vector(s.interface_displacement(), 2 * interface_nodes_, "interface_displacement"),
-          checked_vector(s.interface_velocity(), 2 * interface_nodes_, "interface_velocity")));
+          info, checked_vector(s.interface_displacement(), interface_nodes_, dimension_, "interface_displacement"),
+          checked_vector(s.interface_velocity(), interface_nodes_, dimension_, "interface_velocity")));
       break;
     }
     default:

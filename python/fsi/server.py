@@ -27,6 +27,13 @@ one coupler at a time (others get BUSY).
 
     sys.exit(fs.serve(PointMass))     # 0 after Stop, 130 after SIGTERM, 3 after --idle-timeout
 
+A 3D solid describes its interface with 3 values per node and faces (triangles and
+quadrilaterals, 3/4 nodes, or quadratic 6/8/9 nodes in gmsh's order); its vectors then carry
+x, y, z per node:
+
+    fs.Interface(coordinates=[[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]],
+                 faces=[[0, 1, 2, 3]], dimension=3)
+
 The methods (positional arguments, in this order):
 
 ``configure(section, dt, end_time, interface_damping, output_dir) -> Interface``
@@ -38,7 +45,8 @@ The methods (positional arguments, in this order):
     parameters are then passed by name. Return an ``Interface`` (or a dict of its
     arguments).
 ``solve_step(step, time, dt, iteration, force) -> (displacement, velocity[, newton_iterations])``
-    ``force`` is a numpy array of 2 values per interface node (interleaved x, y), already
+    ``force`` is a numpy array of d values per interface node (interleaved x, y and, for a
+    3D interface, z), already
     checked for size and finiteness. Return arrays of the same size. Every call starts
     from the last accepted state: this module puts it back before a repeated call (see
     ``restart`` below). Raise ``SolverFailed`` (or an exception in ``solver_errors``) when
@@ -111,9 +119,9 @@ class _BadSequence(Exception):
     pass
 
 
-def zeros(nodes):
-    """A zero vector of 2 values per interface node."""
-    return np.zeros(2 * nodes)
+def zeros(nodes, dimension=2):
+    """A zero vector of ``dimension`` values per interface node (2 or 3)."""
+    return np.zeros(dimension * nodes)
 
 
 def apply_overrides(scene, overrides):
@@ -132,43 +140,66 @@ def apply_overrides(scene, overrides):
     return scene
 
 
-def _vector(values, what, size=None):
+def _vector(values, what, size=None, per_node=2):
     try:
         v = np.asarray(values, dtype=float).reshape(-1)
     except (TypeError, ValueError) as e:
         raise ValueError(f"{what} is not a vector of numbers ({e})") from None
     if size is not None and v.size != size:
-        raise ValueError(f"{what} has {v.size} values, expected {size} (2 per interface node)")
+        raise ValueError(f"{what} has {v.size} values, expected {size} ({per_node} per interface node)")
     return v
 
 
+_FACE_SIZES = (3, 4, 6, 8, 9)  # triangles (3, 6 nodes) and quadrilaterals (4, 8, 9), gmsh node order
+
+
 class Interface:
-    """The interface mesh: ``coordinates`` (n x 2 or 2n interleaved, reference configuration
-    [m]) and either ``segments`` (pairs of local node indices: 2-node line elements) or
-    ``lumped_measure`` (n values, the diagonal of int N^T N: a point interface). Optional:
-    ``node_ids`` (your numbers, default 0..n-1), ``initial_displacement`` and
-    ``initial_velocity`` (2n; default at rest)."""
+    """The interface mesh, in 2D or 3D (``dimension``; default 2).
+
+    ``coordinates``: n x dimension (or interleaved), reference configuration [m]. Then exactly
+    one of: ``segments`` (2D: pairs of local node indices, 2-node lines), ``faces`` (3D: a list
+    of faces, each a list of 3, 4, 6, 8 or 9 local node indices: linear and quadratic triangles
+    and quadrilaterals in gmsh's node order) or ``lumped_measure`` (n values, the diagonal of
+    int N^T N: a point interface). Optional: ``node_ids`` (your numbers, default 0..n-1),
+    ``initial_displacement`` and ``initial_velocity`` (dimension x n; default at rest)."""
 
     def __init__(self, coordinates, segments=None, lumped_measure=None, node_ids=None,
-                 initial_displacement=None, initial_velocity=None):
+                 initial_displacement=None, initial_velocity=None, faces=None, dimension=2):
+        if dimension not in (2, 3):
+            raise ValueError(f"Interface.dimension is {dimension}: must be 2 or 3")
+        self.dimension = d = int(dimension)
         c = _vector(coordinates, "Interface.coordinates")
-        if c.size == 0 or c.size % 2:
-            raise ValueError(f"Interface.coordinates has {c.size} values: need 2 per node, at least one node")
+        if c.size == 0 or c.size % d:
+            raise ValueError(f"Interface.coordinates has {c.size} values: need {d} per node, at least one node")
         if not np.all(np.isfinite(c)):
             raise ValueError("Interface.coordinates is not finite")
         self.coordinates = c
-        n = c.size // 2
-        if (segments is None) == (lumped_measure is None):
-            raise ValueError("Interface needs exactly one of segments (a polyline) or lumped_measure (points)")
+        n = c.size // d
+        if sum(x is not None for x in (segments, faces, lumped_measure)) != 1:
+            raise ValueError("Interface needs exactly one of segments (2D), faces (3D) or lumped_measure (points)")
         self.segments = None
+        self.faces = None
         self.lumped_measure = None
         if segments is not None:
+            if d != 2:
+                raise ValueError("Interface.segments describe a 2D interface: in 3D give faces")
             s = np.asarray(segments, dtype=np.int64).reshape(-1)
             if s.size == 0 or s.size % 2 or s.min() < 0 or s.max() >= n:
                 raise ValueError(f"Interface.segments must be pairs of node indices in [0, {n})")
             self.segments = s
+        elif faces is not None:
+            if d != 3:
+                raise ValueError("Interface.faces describe a 3D interface: give dimension=3")
+            self.faces = [np.asarray(f, dtype=np.int64).reshape(-1) for f in faces]
+            if not self.faces:
+                raise ValueError("Interface.faces is empty")
+            for i, f in enumerate(self.faces):
+                if f.size not in _FACE_SIZES:
+                    raise ValueError(f"Interface.faces[{i}] has {f.size} nodes: a face has 3, 4, 6, 8 or 9")
+                if f.min() < 0 or f.max() >= n:
+                    raise ValueError(f"Interface.faces[{i}] has a node index outside [0, {n})")
         else:
-            m = _vector(lumped_measure, "Interface.lumped_measure", n)
+            m = _vector(lumped_measure, "Interface.lumped_measure", n, 1)
             if not np.all(np.isfinite(m)) or not np.all(m > 0):
                 raise ValueError("Interface.lumped_measure must be finite and > 0 at every node")
             self.lumped_measure = m
@@ -176,19 +207,30 @@ class Interface:
         if self.node_ids.size != n or len(set(self.node_ids.tolist())) != n:
             raise ValueError(f"Interface.node_ids must be {n} distinct numbers")
         self.initial_displacement = (np.zeros(0) if initial_displacement is None else
-                                     _vector(initial_displacement, "Interface.initial_displacement", 2 * n))
+                                     _vector(initial_displacement, "Interface.initial_displacement", d * n, d))
         self.initial_velocity = (np.zeros(0) if initial_velocity is None else
-                                 _vector(initial_velocity, "Interface.initial_velocity", 2 * n))
+                                 _vector(initial_velocity, "Interface.initial_velocity", d * n, d))
 
     @property
     def nodes(self):
-        return self.coordinates.size // 2
+        return self.coordinates.size // self.dimension
+
+    @property
+    def values(self):
+        """Values of an interface vector: dimension per node."""
+        return self.coordinates.size
 
     def to_proto(self, mesh):
+        if self.dimension != 2:
+            mesh.dimension = self.dimension  # 0 (absent) = 2: a 2D interface sends what it always did
         mesh.node_ids.extend(int(i) for i in self.node_ids)
         mesh.coordinates.extend(float(x) for x in self.coordinates)
         if self.segments is not None:
             mesh.segments.extend(int(i) for i in self.segments)
+        elif self.faces is not None:
+            for f in self.faces:
+                mesh.face_sizes.append(int(f.size))
+                mesh.faces.extend(int(i) for i in f)
         else:
             mesh.lumped_measure.extend(float(x) for x in self.lumped_measure)
         mesh.initial_displacement.extend(float(x) for x in self.initial_displacement)
@@ -196,8 +238,8 @@ class Interface:
 
 
 class NodalMatrix:
-    """A sparse scalar matrix on the interface nodes (fsi.v1.NodalMatrix): it acts on the x
-    and y components alike. Duplicate (row, col) entries add up."""
+    """A sparse scalar matrix on the interface nodes (fsi.v1.NodalMatrix): it acts on every
+    component (x, y and, in 3D, z) alike. Duplicate (row, col) entries add up."""
 
     def __init__(self, size, rows, cols, values):
         self.size = int(size)
@@ -224,8 +266,9 @@ class NodalMatrix:
         return a
 
     def matvec(self, v):
-        """(M (x) I_2) v for an interleaved vector v of 2 values per node."""
-        v = np.asarray(v, dtype=float).reshape(-1, 2)
+        """(M (x) I_d) v for an interleaved vector v of d values per node (d = v.size / size)."""
+        v = np.asarray(v, dtype=float)
+        v = v.reshape(self.size, -1) if self.size else v.reshape(0, 2)
         out = np.zeros_like(v)
         np.add.at(out, self.rows, self.values[:, None] * v[self.cols])
         return out.reshape(-1)
@@ -498,14 +541,15 @@ class Server:
         reply.configure.interface_nodes = result.nodes
 
     def _solve(self, st, reply):
-        n2 = 2 * self.interface.nodes
+        d = self.interface.dimension
+        n2 = d * self.interface.nodes
         force = np.array(st.interface_force, dtype=float)
         if force.size != n2:
             raise InvalidArgument(f"'interface_force' has {force.size} values, expected {n2}")
         bad = np.flatnonzero(~np.isfinite(force))
         if bad.size:
             i = int(bad[0])
-            raise InvalidArgument(f"'interface_force' is not finite at node {i // 2} ({'xy'[i % 2]}): {force[i]}")
+            raise InvalidArgument(f"'interface_force' is not finite at node {i // d} ({'xyz'[i % d]}): {force[i]}")
         if self._dirty:
             self._restore()  # a repeated solve_step: start again from the last accepted state
         self._dirty = True
@@ -522,12 +566,12 @@ class Server:
         out = reply.solid_step
         for what, values, field in (("displacement", result[0], out.interface_displacement),
                                     ("velocity", result[1], out.interface_velocity)):
-            v = _vector(values, f"solve_step's {what}", n2)
+            v = _vector(values, f"solve_step's {what}", n2, d)
             bad = np.flatnonzero(~np.isfinite(v))
             if bad.size:
                 i = int(bad[0])
-                raise SolverFailed(f"solid step ({what}) produced a non-finite value at node {i // 2} "
-                                   f"({'xy'[i % 2]}): {v[i]}")
+                raise SolverFailed(f"solid step ({what}) produced a non-finite value at node {i // d} "
+                                   f"({'xyz'[i % d]}): {v[i]}")
             field.extend(v.tolist())
         out.newton_iterations = int(result[2]) if len(result) == 3 else 1
 

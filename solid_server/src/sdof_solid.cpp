@@ -1,12 +1,14 @@
 #include "fsi/models/sdof_solid.hpp"
 
+#include <fmt/format.h>
+
 #include "fsi/common/scene_reader.hpp"
 
 namespace fsi::models {
 namespace {
-Eigen::Vector2d vector2(const schema::Reader& r, const std::string& key) {
-  const auto v = r.vector2(key);
-  return {v[0], v[1]};
+Eigen::VectorXd vector_of(const schema::Reader& r, const std::string& key, int dim) {
+  const auto v = r.vector(key, dim);
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), dim);
 }
 }  // namespace
 
@@ -15,10 +17,12 @@ void SdofSolid::configure(const ConfigSection& section, const SolidSetup& setup)
   mass_ = s.get<double>("mass");
   damping_ = s.get<double>("damping");
   stiffness_ = s.get<double>("stiffness");
-  measure_ = s.get<double>("interface_measure");
-  force_ = vector2(s, "force");
-  d0_ = vector2(s, "initial_displacement");
-  v0_ = vector2(s, "initial_velocity");
+  interface_ = read_model_interface(s, "interface_measure");
+  measure_ = interface_.measure;
+  const int dim = interface_.dimension();
+  force_ = vector_of(s, "force", dim);
+  d0_ = vector_of(s, "initial_displacement", dim);
+  v0_ = vector_of(s, "initial_velocity", dim);
   gamma_ = setup.interface_damping;
   interface_damping_ = gamma_ * measure_;  // M_fs = gamma_N1 * M_G (until the coupler gives its M_G)
   d_n_ = d_ = d0_;
@@ -26,19 +30,18 @@ void SdofSolid::configure(const ConfigSection& section, const SolidSetup& setup)
 }
 
 void SdofSolid::set_interface_mass(const NodalMatrix& m) {
-  if (m.rows() != 1 || m.cols() != 1)
-    throw std::invalid_argument("sdof: interface mass must be 1 x 1 (one interface node), got " +
-                                std::to_string(m.rows()) + " x " + std::to_string(m.cols()));
-  interface_damping_ = gamma_ * m.coeff(0, 0);
+  const Eigen::Index n = static_cast<Eigen::Index>(interface_.mesh.nodes());
+  if (m.rows() != n || m.cols() != n)
+    throw std::invalid_argument(fmt::format("sdof: interface mass must be {} x {} (its interface nodes), got {} x {}",
+                                            n, n, m.rows(), m.cols()));
+  // A rigid body: the damping of a uniform velocity, 1^T M_G 1 (M_G's only entry for a point).
+  interface_damping_ = gamma_ * (n == 1 ? m.coeff(0, 0) : m.sum());
 }
 
 InterfaceMeshData SdofSolid::interface() const {
-  InterfaceMeshData data;
-  data.node_ids = {0};
-  data.coordinates = Eigen::MatrixX2d::Zero(1, 2);
-  data.lumped_measure = Eigen::VectorXd::Constant(1, measure_);
-  data.initial_displacement = d0_;
-  data.initial_velocity = v0_;
+  InterfaceMeshData data = interface_.mesh;
+  data.initial_displacement = interface_.uniform(d0_);
+  data.initial_velocity = interface_.uniform(v0_);
   data.mass_per_area = mass_ / measure_;
   return data;
 }
@@ -48,17 +51,19 @@ SolidStepResult SdofSolid::solve_step(const StepInfo& info, const Eigen::VectorX
   const double c = damping_ + interface_damping_;
   // m (d - d_n - dt v_n)/dt^2 + c (d - d_n)/dt + k d = F
   const double lhs = mass_ / (dt * dt) + c / dt + stiffness_;
-  const Eigen::Vector2d rhs =
-      interface_force.head<2>() + force_ + mass_ * (d_n_ / (dt * dt) + v_n_ / dt) + c * d_n_ / dt;
+  const Eigen::VectorXd rhs =
+      interface_.resultant(interface_force) + force_ + mass_ * (d_n_ / (dt * dt) + v_n_ / dt) + c * d_n_ / dt;
   d_ = rhs / lhs;
   v_ = (d_ - d_n_) / dt;
-  return {d_, v_, 1};
+  return {interface_.uniform(d_), interface_.uniform(v_), 1};
 }
 
 std::map<std::string, double> SdofSolid::accept_step(const StepInfo&) {
   d_n_ = d_;
   v_n_ = v_;
-  return {{"d_x", d_[0]}, {"d_y", d_[1]}, {"v_x", v_[0]}, {"v_y", v_[1]}};
+  std::map<std::string, double> probes{{"d_x", d_[0]}, {"d_y", d_[1]}, {"v_x", v_[0]}, {"v_y", v_[1]}};
+  if (d_.size() == 3) probes["d_z"] = d_[2], probes["v_z"] = v_[2];
+  return probes;
 }
 
 void SdofSolid::save_state(StateArchive& state) {
@@ -67,8 +72,9 @@ void SdofSolid::save_state(StateArchive& state) {
 }
 
 void SdofSolid::load_state(const StateArchive& state) {
-  d_n_ = d_ = state.vector("sdof.d_n", 2);
-  v_n_ = v_ = state.vector("sdof.v_n", 2);
+  const Eigen::Index dim = interface_.dimension();
+  d_n_ = d_ = state.vector("sdof.d_n", dim);
+  v_n_ = v_ = state.vector("sdof.v_n", dim);
 }
 
 }  // namespace fsi::models

@@ -48,6 +48,27 @@ def python_solid(env):
         print(f"{key}: max |C++ - Python| = {err:.1e}")
 
 
+def python_solid_3d(env):
+    """A 3D external solid: the Python solid's rigid plate (quadrilateral faces) against the
+    surrogate fluid's plate of triangles, over sockets, gives the C++ solid's history to
+    round-off, and the interface vectors carry 3 values per node."""
+    cpp, py = env.out("cpp3d"), env.out("py3d")
+    code, log = env.fsi("sdof_3d.yaml", cpp, "time.output_every=0")
+    assert code == 0, log
+    solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
+    code, log = env.fsi("sdof_3d.yaml", py, "time.output_every=0", extra=("--solid-command", solid))
+    assert code == 0, log
+    s = summary(py)
+    assert s["servers"]["solid"]["name"] == "python sdof_solid.py", s["servers"]
+    assert s["interface"]["solid_nodes"] == 9 and s["interface"]["fluid_nodes"] == 16, s["interface"]
+    a, b = probes(os.path.join(cpp, "probes.csv")), probes(os.path.join(py, "probes.csv"))
+    for key in ("solid.d_z", "solid.v_z"):
+        err = max(abs(x - y) for x, y in zip(a[key], b[key]))
+        assert len(a[key]) == len(b[key]) == 500 and err <= 1e-13, (key, err)
+        print(f"{key}: max |C++ - Python| = {err:.1e}")
+    assert max(abs(x) for x in b["solid.d_x"] + b["solid.d_y"]) == 0.0
+
+
 def killed_server(env):
     """A server killed mid-run: the coupler names it, exits non-zero within seconds, and
     every accepted step is on disk."""
@@ -438,5 +459,5 @@ def bad_replies(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (end_to_end, python_solid, killed_server, bad_messages, strict_protocol, sessions, added_mass,
+    main({f.__name__: f for f in (end_to_end, python_solid, python_solid_3d, killed_server, bad_messages, strict_protocol, sessions, added_mass,
                                   config_errors, interrupt, curve, misbehaving_solid, bad_replies)})

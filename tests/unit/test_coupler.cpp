@@ -10,6 +10,7 @@
 #include "fsi/coupling/coupler.hpp"
 #include "fsi/models/sdof_solid.hpp"
 #include "fsi/models/surrogate_fluid.hpp"
+#include "fsi/solid/fem_solid.hpp"
 
 namespace {
 
@@ -46,17 +47,18 @@ void read_csv(const fs::path& path, std::vector<std::string>& columns, std::vect
   }
 }
 
-Run run_scene(const std::vector<std::string>& overrides) {
-  const auto scene = fsi::Scene::load(fs::path(FSI_SOURCE_DIR) / "configs/sdof_model.yaml", overrides);
+template <class Solid = fsi::models::SdofSolid>
+Run run_scene(const std::vector<std::string>& overrides, const std::string& file = "configs/sdof_model.yaml") {
+  const auto scene = fsi::Scene::load(fs::path(FSI_SOURCE_DIR) / file, overrides);
   const auto out = fs::temp_directory_path() /
                    ("fsi_unit_" + std::to_string(::getpid()) + "_" + std::to_string(std::hash<std::string>{}([&] {
-                      std::string s;
+                      std::string s = file + ";";
                       for (auto& o : overrides) s += o + ";";
                       return s;
                     }())));
   fs::remove_all(out);
   fs::create_directories(out);
-  fsi::models::SdofSolid solid;
+  Solid solid;
   fsi::models::SurrogateFluid fluid;
   fsi::RunReport report(out, scene, "test");
   fsi::coupling::Coupler coupler(solid, fluid, scene, out);
@@ -105,6 +107,98 @@ TEST_P(AppendixRecurrence, Algorithm2MatchesTheBdf1RecurrenceToRoundOff) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Gammas, AppendixRecurrence, ::testing::Values(0.0, 1.0, 10.0, 100.0));
+
+// The same recurrence in 3D: at a point interface with 3 values per node, and on a rigid
+// plate of area 1 whose solid (quadrilaterals) and fluid (triangles) faces do not match, so
+// the force goes through the transposed face projection and M_G through H^T M_f H.
+TEST(Appendix3d, APointInterfaceIn3dFollowsTheRecurrence) {
+  const auto run = run_scene({"solid.dimension=3", "fluid.dimension=3", "fluid.force=[0, 1.282, 0]"});
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  const auto d = run.column("solid.d_y"), dx = run.column("solid.d_x"), dz = run.column("solid.d_z");
+  const auto expected = recurrence(10, 500);
+  ASSERT_EQ(d.size(), expected.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    ASSERT_NEAR(d[i], expected[i], 1e-14) << "step " << i + 1;
+    ASSERT_EQ(dx[i], 0.0);
+    ASSERT_EQ(dz[i], 0.0);
+  }
+}
+
+class Appendix3dPlate : public ::testing::TestWithParam<double> {};
+
+TEST_P(Appendix3dPlate, ANonMatchingPlateFollowsTheRecurrence) {
+  const double gamma = GetParam();
+  const auto run = run_scene({"coupling.gamma_n1=" + std::to_string(gamma)}, "configs/sdof_3d.yaml");
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  const auto d = run.column("solid.d_z");
+  const auto f = run.column("fluid.force_z");
+  const auto expected = recurrence(gamma, 500);
+  ASSERT_EQ(d.size(), expected.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    ASSERT_NEAR(d[i], expected[i], 1e-12) << "step " << i + 1;
+    ASSERT_NEAR(f[i], 1.282, 1e-12);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Gammas, Appendix3dPlate, ::testing::Values(0.0, 10.0, 100.0));
+
+TEST(Appendix3d, APlateWithAddedMassAndIterationsEqualsThePointProblem) {
+  // Added mass shared by the fluid's nodes by area, iterated with Aitken: the plate's normal
+  // motion is the 2D point problem's, step by step and iteration by iteration.
+  const std::vector<std::string> common = {
+      "fluid.added_mass=0.8",       "coupling.acceleration=aitken",        "coupling.relaxation=0.5",
+      "coupling.iterations.max=20", "coupling.iterations.tolerance=1e-10", "time.end=2"};
+  auto plate_set = common;
+  plate_set.push_back("time.output_every=0");
+  auto point_set = common;
+  point_set.push_back("fluid.force=1.282");
+  const auto plate = run_scene(plate_set, "configs/sdof_3d.yaml");
+  const auto point = run_scene(point_set);
+  ASSERT_EQ(plate.outcome.status, "completed") << plate.outcome.reason;
+  ASSERT_EQ(point.outcome.status, "completed") << point.outcome.reason;
+  const auto dz = plate.column("solid.d_z"), dx = point.column("solid.d_x");
+  ASSERT_EQ(dz.size(), dx.size());
+  for (std::size_t i = 0; i < dz.size(); ++i) ASSERT_NEAR(dz[i], dx[i], 1e-10) << "step " << i + 1;
+  EXPECT_EQ(plate.iteration_rows.size(), point.iteration_rows.size());
+}
+
+TEST(Block3d, AFiniteStrainBlockUnderTheSurrogatePlateIsInUniaxialStress) {
+  // configs/block_3d.yaml: St. Venant-Kirchhoff, dead load F on A = 1, rollers. The axial
+  // stretch solves lambda Y (lambda^2 - 1) / 2 = F / A; the lateral Green-Lagrange strain is
+  // -nu times the axial one. Bisection to round-off.
+  const double Y = 2 * 1e6 * 1.3, P = -2e5, nu = 0.3;
+  double lo = 0.5, hi = 1.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (mid * Y * (mid * mid - 1) / 2 > P ? hi : lo) = mid;
+  }
+  const double lambda = 0.5 * (lo + hi);
+  const double lateral = std::sqrt(1 - 2 * nu * (lambda * lambda - 1) / 2);
+  const auto run = run_scene<fsi::solid::FemSolid>({"time.output_every=0"}, "configs/block_3d.yaml");
+  ASSERT_EQ(run.outcome.status, "completed") << run.outcome.reason;
+  for (const std::string probe : {"corner", "centre"})
+    EXPECT_NEAR(run.column("solid." + probe + "_z").back(), (lambda - 1) * 0.2, 1e-9) << probe;
+  EXPECT_NEAR(run.column("solid.corner_x").back(), lateral - 1, 1e-9);
+  EXPECT_NEAR(run.column("solid.corner_y").back(), lateral - 1, 1e-9);
+  EXPECT_NEAR(run.column("solid.centre_x").back(), (lateral - 1) * 0.5, 1e-9);
+  EXPECT_NEAR(run.column("fluid.force_z").back(), -2e5, 1e-6);
+}
+
+TEST(InterfaceGap, AFluidInterfaceOffTheSolidsIsWarnedThenRefusedNamingTheKey) {
+  // The solid plate's cells are 0.5 m wide; the fluid's plate lifted by 0.1 m (20 %) runs with
+  // a warning, by 0.3 m (60 %) is refused unless coupling.interface_gap.refuse allows it.
+  const std::vector<std::string> quick = {"time.end=0.1", "time.output_every=0"};
+  auto with = [&](std::vector<std::string> extra) {
+    extra.insert(extra.end(), quick.begin(), quick.end());
+    return run_scene(extra, "configs/sdof_3d.yaml");
+  };
+  EXPECT_EQ(with({"fluid.surface.centre=[0, 0, 0.1]"}).outcome.status, "completed");
+  const auto refused = with({"fluid.surface.centre=[0, 0, 0.3]"});
+  EXPECT_EQ(refused.outcome.status, "failed");
+  EXPECT_NE(refused.outcome.reason.find("coupling.interface_gap.refuse"), std::string::npos) << refused.outcome.reason;
+  EXPECT_NE(refused.outcome.reason.find("60 %"), std::string::npos) << refused.outcome.reason;
+  EXPECT_EQ(with({"fluid.surface.centre=[0, 0, 0.3]", "coupling.interface_gap.refuse=0"}).outcome.status, "completed");
+}
 
 TEST(Appendix, SettlesToFOverKLaterAsGammaGrows) {
   double previous = 0;

@@ -10,8 +10,9 @@
 //   - the output: the pressure at every node, the velocity at a point of a triangle.
 // The two parts, make_p1p1_element (flow_element_p1p1.cpp: P1/P1 SUPG/PSPG/LSIC) and
 // make_p2p1_element (flow_element_p2p1.cpp: isoparametric Taylor-Hood P2/P1), are selected by
-// the scene's fluid.element name. (The midpoints of a 6-node mesh follow their vertices, in
-// the P2 nodal pressure and in the vertex-driven mesh motion, by FluidMesh::interpolate_midpoints.)
+// the scene's fluid.element name; in 3D (FlowSolver3) make_p2p1_tet_element (10-node tetrahedra). (The midpoints of a
+// 6-node mesh follow their vertices, in the P2 nodal pressure and in the vertex-driven mesh motion, by
+// FluidMesh::interpolate_midpoints.)
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
@@ -35,15 +36,17 @@ struct DofLayout {
 };
 
 // What the local assembly of one nonlinear iteration reads (per node, or per unknown).
-struct AssemblyInput {
-  const Eigen::MatrixX2d& X;              // positions (current configuration)
-  const Eigen::MatrixX2d& mesh_velocity;  // w
-  const Eigen::MatrixX2d& body;           // body force f
-  const Eigen::VectorXd& U_lin;           // linearisation velocity u* (every unknown)
-  const Eigen::VectorXd& history;         // (alpha1 u_n + alpha2 u_{n-1}) / dt (every unknown; 0 if steady)
+template <int Dim>
+struct AssemblyInputT {
+  const NodeMatrix<Dim>& X;              // positions (current configuration)
+  const NodeMatrix<Dim>& mesh_velocity;  // w
+  const NodeMatrix<Dim>& body;           // body force f
+  const Eigen::VectorXd& U_lin;          // linearisation velocity u* (every unknown)
+  const Eigen::VectorXd& history;        // (alpha1 u_n + alpha2 u_{n-1}) / dt (every unknown; 0 if steady)
   const FlowParameters& params;
   double alpha0_dt = 0, dt = 0;  // 0 if steady
 };
+using AssemblyInput = AssemblyInputT<2>;
 
 // The local matrix and right-hand side of a triangle or an interface edge, in the element's
 // local order of unknowns (element_dofs).
@@ -62,18 +65,24 @@ struct InterfaceEdge {
 };
 
 // What the Nitsche terms read.
-struct NitscheInput {
-  const Eigen::MatrixX2d& X;    // current positions
-  const Eigen::MatrixX2d& X_n;  // positions of the last accepted step (penalty_on_step_start)
-  const Eigen::VectorXd& v_s;   // interface velocity, 2 per interface node
+template <int Dim>
+struct NitscheInputT {
+  const NodeMatrix<Dim>& X;    // current positions
+  const NodeMatrix<Dim>& X_n;  // positions of the last accepted step (penalty_on_step_start)
+  const Eigen::VectorXd& v_s;  // interface velocity, Dim per interface node
   const FlowParameters& params;
 };
+using NitscheInput = NitscheInputT<2>;
 
-class FlowElement {
+template <int Dim>
+class FlowElementT {
  public:
-  virtual ~FlowElement() = default;
+  using AssemblyInput = AssemblyInputT<Dim>;
+  using NitscheInput = NitscheInputT<Dim>;
+  using Mesh = MeshOf<Dim>;
+  virtual ~FlowElementT() = default;
   virtual const char* name() const = 0;  // fluid.element: "p1p1", "p2p1" (checkpoints)
-  virtual const FluidMesh& mesh() const = 0;
+  virtual const Mesh& mesh() const = 0;
   virtual DofLayout layout() const = 0;
   virtual int local_size() const = 0;                     // unknowns per triangle
   virtual void element_dofs(int e, int* dofs) const = 0;  // local_size() global unknowns
@@ -99,17 +108,22 @@ class FlowElement {
   // The Nitsche terms of the edge (overwrites `out`), in the triangle's local order.
   virtual void nitsche(const InterfaceEdge& edge, const NitscheInput& in, LocalSystem& out) const = 0;
   // int N_i N_j over the edge at positions X, on the interface indices.
-  virtual void interface_mass(const InterfaceEdge& edge, const Eigen::MatrixX2d& X,
+  virtual void interface_mass(const InterfaceEdge& edge, const NodeMatrix<Dim>& X,
                               std::vector<Eigen::Triplet<double>>& mass) const = 0;
 
   // --- output ---
   virtual Eigen::VectorXd nodal_pressure(const Eigen::VectorXd& U) const = 0;
-  virtual Eigen::Vector2d velocity_at(int e, const Eigen::Vector3d& bary, const Eigen::VectorXd& U) const = 0;
+  virtual Point<Dim> velocity_at(int e, const Eigen::Matrix<double, Dim + 1, 1>& bary,
+                                 const Eigen::VectorXd& U) const = 0;
 };
+using FlowElement = FlowElementT<2>;
 
 // Each checks (P2/P1: converts a linear mesh to straight 6-node triangles) the mesh; throws
 // std::invalid_argument when the element cannot use it.
 std::unique_ptr<FlowElement> make_p1p1_element(FluidMesh mesh);
 std::unique_ptr<FlowElement> make_p2p1_element(FluidMesh mesh);
+// 3D: isoparametric Taylor-Hood P2/P1 on 10-node tetrahedra (flow_element_p2p1_tet.cpp; a
+// linear mesh gets straight midpoints). No Nitsche interface yet.
+std::unique_ptr<FlowElementT<3>> make_p2p1_tet_element(TetMesh mesh);
 
 }  // namespace fsi::fluid::detail

@@ -28,9 +28,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+template <int Dim>
 struct DirichletCondition {
   std::vector<int> nodes;
-  VelocityFunction velocity;
+  VelocityFunctionT<Dim> velocity;
 };
 
 struct SymmetryCondition {
@@ -45,16 +46,18 @@ struct StrongConstraints {
 };
 
 // pressure_dof < 0: no pressure reference.
-StrongConstraints strong_constraints(const detail::DofLayout& dof, const std::vector<DirichletCondition>& dirichlet,
-                                     const std::vector<SymmetryCondition>& symmetry, const Eigen::MatrixX2d& X,
+template <int Dim>
+StrongConstraints strong_constraints(const detail::DofLayout& dof,
+                                     const std::vector<DirichletCondition<Dim>>& dirichlet,
+                                     const std::vector<SymmetryCondition>& symmetry, const NodeMatrix<Dim>& X,
                                      double time, int pressure_dof, double pressure_value) {
   StrongConstraints k{std::vector<char>(static_cast<std::size_t>(dof.dofs), 0), Eigen::VectorXd::Zero(dof.dofs)};
   for (const auto& sym : symmetry)
     for (int node : sym.nodes) k.on[static_cast<std::size_t>(dof.velocity(node, sym.component))] = 1;
   for (const auto& dc : dirichlet)
     for (int node : dc.nodes) {
-      const Eigen::Vector2d v = dc.velocity(X.row(node).transpose(), time);
-      for (int c = 0; c < 2; ++c) {
+      const Point<Dim> v = dc.velocity(X.row(node).transpose(), time);
+      for (int c = 0; c < Dim; ++c) {
         k.on[static_cast<std::size_t>(dof.velocity(node, c))] = 1;
         k.value(dof.velocity(node, c)) = v(c);
       }
@@ -112,12 +115,28 @@ int symmetry_component(const FluidMesh& mesh, const std::string& group) {
   throw std::runtime_error("symmetry boundary '" + group + "' is not axis-aligned (only x = const or y = const)");
 }
 
+// 3D: the coordinate that is constant over the group's nodes (x, y or z = const).
+int symmetry_component(const TetMesh& mesh, const std::string& group) {
+  const auto nodes = mesh.boundary_nodes({group});
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (int n : nodes) {
+    lo = lo.cwiseMin(mesh.nodes.row(n).transpose());
+    hi = hi.cwiseMax(mesh.nodes.row(n).transpose());
+  }
+  const Eigen::Vector3d span = hi - lo;
+  for (int c = 0; c < 3; ++c)
+    if (span(c) <= 1e-8 * span.norm()) return c;
+  throw std::runtime_error("symmetry boundary '" + group +
+                           "' is not axis-aligned (only x = const, y = const or z = const)");
+}
+
 // ||u_new - u_old|| / ||u_new|| over the velocity unknowns.
+template <int Dim>
 double relative_velocity_change(const Eigen::VectorXd& u_new, const Eigen::VectorXd& u_old, int nodes,
                                 const detail::DofLayout& dof) {
   double diff = 0, norm = 0;
   for (int i = 0; i < nodes; ++i)
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < Dim; ++c) {
       const int k = dof.velocity(i, c);
       diff += std::pow(u_new(k) - u_old(k), 2);
       norm += std::pow(u_new(k), 2);
@@ -125,10 +144,14 @@ double relative_velocity_change(const Eigen::VectorXd& u_new, const Eigen::Vecto
   return std::sqrt(diff / std::max(norm, 1e-300));
 }
 
-Eigen::VectorXd flatten(const Eigen::MatrixX2d& m) { return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size()); }
+template <int Dim>
+Eigen::VectorXd flatten(const NodeMatrix<Dim>& m) {
+  return Eigen::Map<const Eigen::VectorXd>(m.data(), m.size());
+}
 
-Eigen::MatrixX2d unflatten(const Eigen::VectorXd& v) {
-  return Eigen::Map<const Eigen::MatrixX2d>(v.data(), v.size() / 2, 2);
+template <int Dim>
+NodeMatrix<Dim> unflatten(const Eigen::VectorXd& v) {
+  return Eigen::Map<const NodeMatrix<Dim>>(v.data(), v.size() / Dim, Dim);
 }
 
 std::unique_ptr<detail::FlowElement> make_element(const std::string& name, FluidMesh mesh) {
@@ -137,10 +160,16 @@ std::unique_ptr<detail::FlowElement> make_element(const std::string& name, Fluid
   throw std::invalid_argument("fluid element must be p1p1 or p2p1, got '" + name + "'");
 }
 
+std::unique_ptr<detail::FlowElementT<3>> make_element(const std::string& name, TetMesh mesh) {
+  if (name == "p2p1") return detail::make_p2p1_tet_element(std::move(mesh));
+  throw std::invalid_argument("3D fluid element must be p2p1 (Taylor-Hood on tetrahedra), got '" + name + "'");
+}
+
 }  // namespace
 
-struct FlowSolver::Impl {
-  std::unique_ptr<detail::FlowElement> element;
+template <int Dim>
+struct BasicFlowSolver<Dim>::Impl {
+  std::unique_ptr<detail::FlowElementT<Dim>> element;
   detail::DofLayout dof;
   int local = 0;                               // unknowns per triangle
   std::vector<int> element_dofs;               // per triangle its `local` unknowns
@@ -148,15 +177,15 @@ struct FlowSolver::Impl {
   Eigen::SparseMatrix<double> matrix, volume;  // the system (constraints applied); the volume terms (reactions)
   Eigen::VectorXd rhs, rhs_volume;
   std::unique_ptr<SparseLu> lu;
-  std::vector<DirichletCondition> dirichlet;
+  std::vector<DirichletCondition<Dim>> dirichlet;
   std::vector<SymmetryCondition> symmetry;
   std::vector<detail::InterfaceEdge> edges;
   int pressure_vertex = -1;
   std::function<double(double)> pressure_value;
-  VelocityFunction body_force;
+  Velocity body_force;
   std::vector<std::vector<double>> thread_values;
 
-  const FluidMesh& mesh() const { return element->mesh(); }
+  const Mesh& mesh() const { return element->mesh(); }
   const int* dofs_of(int e) const {
     return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)];
   }
@@ -172,13 +201,14 @@ struct FlowSolver::Impl {
     for (int i = 0; i < local; ++i) b(d[i]) += s.rhs(i);
   }
   void build_pattern();
-  int assemble_volume(const detail::AssemblyInput& in, int threads, double& bad);
+  int assemble_volume(const detail::AssemblyInputT<Dim>& in, int threads, double& bad);
 };
 
 // Sparsity: per column the sorted rows coupled to it by some triangle; the CSC structure and
 // every triangle's positions in it.
-void FlowSolver::Impl::build_pattern() {
-  const int ndof = dof.dofs, ne = mesh().triangle_count();
+template <int Dim>
+void BasicFlowSolver<Dim>::Impl::build_pattern() {
+  const int ndof = dof.dofs, ne = mesh().cell_count();
   local = element->local_size();
   element_dofs.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local));
   for (int e = 0; e < ne; ++e) element->element_dofs(e, &element_dofs[static_cast<std::size_t>(e * local)]);
@@ -219,12 +249,13 @@ void FlowSolver::Impl::build_pattern() {
 
 // The volume terms into `volume` and `rhs_volume` (threads: each its own copy of the values,
 // summed in thread order). Returns an inverted triangle (with its `bad` measure), or -1.
-int FlowSolver::Impl::assemble_volume(const detail::AssemblyInput& in, int nthreads, double& bad) {
+template <int Dim>
+int BasicFlowSolver<Dim>::Impl::assemble_volume(const detail::AssemblyInputT<Dim>& in, int nthreads, double& bad) {
   const std::size_t nnz = static_cast<std::size_t>(matrix.nonZeros());
   thread_values.resize(static_cast<std::size_t>(nthreads));
   std::vector<Eigen::VectorXd> thread_rhs(static_cast<std::size_t>(nthreads), Eigen::VectorXd::Zero(dof.dofs));
   int bad_element = -1;
-  const int ne = mesh().triangle_count();
+  const int ne = mesh().cell_count();
 #pragma omp parallel num_threads(nthreads)
   {
 #ifdef _OPENMP
@@ -262,17 +293,19 @@ int FlowSolver::Impl::assemble_volume(const detail::AssemblyInput& in, int nthre
 }
 
 // Everything a solve of one time level fixes before its iterations.
-struct FlowSolver::Step {
+template <int Dim>
+struct BasicFlowSolver<Dim>::Step {
   double time = 0, dt = 0;  // dt: 0 if steady
   double alpha0_dt = 0;     // alpha0 / dt (0 if steady)
-  Eigen::MatrixX2d mesh_velocity, body;
+  Nodes mesh_velocity, body;
   Eigen::VectorXd U_lin;    // linearisation velocity of the first iteration
   Eigen::VectorXd history;  // (alpha1 u_n + alpha2 u_{n-1}) / dt
   StrongConstraints constraints;
   bool retrial = false;  // a repeated solve of the time level: start from its last solution
 };
 
-FlowSolver::FlowSolver(FluidMesh mesh, FlowParameters params, const std::string& element)
+template <int Dim>
+BasicFlowSolver<Dim>::BasicFlowSolver(Mesh mesh, FlowParameters params, const std::string& element)
     : params_(params), impl_(std::make_unique<Impl>()) {
   auto& im = *impl_;
   im.element = make_element(element, std::move(mesh));
@@ -284,72 +317,102 @@ FlowSolver::FlowSolver(FluidMesh mesh, FlowParameters params, const std::string&
   interface_segments_.resize(0, 2);
 }
 
-FlowSolver::~FlowSolver() = default;
-FlowSolver::FlowSolver(FlowSolver&&) noexcept = default;
-FlowSolver& FlowSolver::operator=(FlowSolver&&) noexcept = default;
+template <int Dim>
+BasicFlowSolver<Dim>::~BasicFlowSolver() = default;
+template <int Dim>
+BasicFlowSolver<Dim>::BasicFlowSolver(BasicFlowSolver&&) noexcept = default;
+template <int Dim>
+BasicFlowSolver<Dim>& BasicFlowSolver<Dim>::operator=(BasicFlowSolver&&) noexcept = default;
 
-const FluidMesh& FlowSolver::mesh() const { return impl_->mesh(); }
-int FlowSolver::dofs() const { return impl_->dof.dofs; }
-const Eigen::SparseMatrix<double>& FlowSolver::last_matrix() const { return impl_->matrix; }
-const Eigen::VectorXd& FlowSolver::last_rhs() const { return impl_->rhs; }
+template <int Dim>
+const typename BasicFlowSolver<Dim>::Mesh& BasicFlowSolver<Dim>::mesh() const {
+  return impl_->mesh();
+}
+template <int Dim>
+int BasicFlowSolver<Dim>::dofs() const {
+  return impl_->dof.dofs;
+}
+template <int Dim>
+const Eigen::SparseMatrix<double>& BasicFlowSolver<Dim>::last_matrix() const {
+  return impl_->matrix;
+}
+template <int Dim>
+const Eigen::VectorXd& BasicFlowSolver<Dim>::last_rhs() const {
+  return impl_->rhs;
+}
 
-void FlowSolver::add_dirichlet(const std::string& group, VelocityFunction velocity) {
+template <int Dim>
+void BasicFlowSolver<Dim>::add_dirichlet(const std::string& group, Velocity velocity) {
   impl_->dirichlet.push_back({mesh().boundary_nodes({group}), std::move(velocity)});
 }
 
-void FlowSolver::add_symmetry(const std::string& group) {
+template <int Dim>
+void BasicFlowSolver<Dim>::add_symmetry(const std::string& group) {
   impl_->symmetry.push_back({mesh().boundary_nodes({group}), symmetry_component(mesh(), group)});
 }
 
-void FlowSolver::set_interface(const std::vector<std::string>& groups) {
-  const auto& m = mesh();
-  interface_nodes_ = m.boundary_nodes(groups);
-  std::map<int, int> local;
-  for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
-  std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // vertex pair -> (triangle, edge)
-  for (int e = 0; e < m.triangle_count(); ++e)
-    for (int k = 0; k < 3; ++k) {
-      const int a = m.triangles(e, k), b = m.triangles(e, (k + 1) % 3);
-      edge_owner[{std::min(a, b), std::max(a, b)}] = {e, k};
+template <int Dim>
+void BasicFlowSolver<Dim>::set_interface(const std::vector<std::string>& groups) {
+  if constexpr (Dim == 3) {
+    if (!groups.empty()) throw std::invalid_argument("the 3D fluid has no Nitsche interface yet");
+    interface_velocity_.resize(0);
+    return;
+  } else {
+    const auto& m = mesh();
+    interface_nodes_ = m.boundary_nodes(groups);
+    std::map<int, int> local;
+    for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
+    std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // vertex pair -> (triangle, edge)
+    for (int e = 0; e < m.triangle_count(); ++e)
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.triangles(e, k), b = m.triangles(e, (k + 1) % 3);
+        edge_owner[{std::min(a, b), std::max(a, b)}] = {e, k};
+      }
+    impl_->edges.clear();
+    std::vector<std::array<int, 2>> segs;
+    for (const auto& name : groups) {
+      const auto& seg = m.boundary(name);
+      for (Eigen::Index s = 0; s < seg.rows(); ++s) {
+        const int a = seg(s, 0), b = seg(s, 1);
+        const auto it = edge_owner.find({std::min(a, b), std::max(a, b)});
+        if (it == edge_owner.end())
+          throw std::runtime_error(
+              fmt::format("interface group '{}': segment ({}, {}) is not a triangle edge", name, a, b));
+        impl_->edges.push_back(impl_->element->interface_edge(it->second.first, it->second.second, a, b, local, segs));
+      }
     }
-  impl_->edges.clear();
-  std::vector<std::array<int, 2>> segs;
-  for (const auto& name : groups) {
-    const auto& seg = m.boundary(name);
-    for (Eigen::Index s = 0; s < seg.rows(); ++s) {
-      const int a = seg(s, 0), b = seg(s, 1);
-      const auto it = edge_owner.find({std::min(a, b), std::max(a, b)});
-      if (it == edge_owner.end())
-        throw std::runtime_error(
-            fmt::format("interface group '{}': segment ({}, {}) is not a triangle edge", name, a, b));
-      impl_->edges.push_back(impl_->element->interface_edge(it->second.first, it->second.second, a, b, local, segs));
-    }
+    interface_segments_.resize(static_cast<Eigen::Index>(segs.size()), 2);
+    for (std::size_t s = 0; s < segs.size(); ++s)
+      interface_segments_.row(static_cast<Eigen::Index>(s)) << segs[s][0], segs[s][1];
+    interface_velocity_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
   }
-  interface_segments_.resize(static_cast<Eigen::Index>(segs.size()), 2);
-  for (std::size_t s = 0; s < segs.size(); ++s)
-    interface_segments_.row(static_cast<Eigen::Index>(s)) << segs[s][0], segs[s][1];
-  interface_velocity_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
 }
 
-void FlowSolver::set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value) {
+template <int Dim>
+void BasicFlowSolver<Dim>::set_pressure_reference(const PointD& point, std::function<double(double)> value) {
   Eigen::Index best = 0;
   (mesh().nodes.topRows(mesh().vertices()).rowwise() - point.transpose()).rowwise().squaredNorm().minCoeff(&best);
   impl_->pressure_vertex = static_cast<int>(best);
   impl_->pressure_value = std::move(value);
 }
 
-void FlowSolver::set_body_force(VelocityFunction force) { impl_->body_force = std::move(force); }
+template <int Dim>
+void BasicFlowSolver<Dim>::set_body_force(Velocity force) {
+  impl_->body_force = std::move(force);
+}
 
-void FlowSolver::set_initial_velocity(const Eigen::MatrixX2d& velocity) {
+template <int Dim>
+void BasicFlowSolver<Dim>::set_initial_velocity(const Nodes& velocity) {
   for (int i = 0; i < mesh().node_count(); ++i)
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < Dim; ++c) {
       const int k = impl_->dof.velocity(i, c);
       U_n_(k) = U_nm1_(k) = U_(k) = velocity(i, c);
     }
 }
 
-FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::MatrixX2d& positions,
-                                        const Eigen::VectorXd& interface_velocity) {
+template <int Dim>
+typename BasicFlowSolver<Dim>::Step BasicFlowSolver<Dim>::begin_step(double time, double dt, const Nodes& positions,
+                                                                     const Eigen::VectorXd& interface_velocity) {
   const auto& im = *impl_;
   const int n = mesh().node_count();
   if (positions.rows() != n) throw std::invalid_argument("FlowSolver::solve: positions has the wrong size");
@@ -357,9 +420,9 @@ FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::Mat
   dt_trial_ = dt;
   if (interface_velocity.size() == 0)
     interface_velocity_.setZero();
-  else if (interface_velocity.size() != 2 * static_cast<Eigen::Index>(interface_nodes_.size()))
+  else if (interface_velocity.size() != Dim * static_cast<Eigen::Index>(interface_nodes_.size()))
     throw std::invalid_argument(fmt::format("interface velocity has {} entries, expected {}", interface_velocity.size(),
-                                            2 * interface_nodes_.size()));
+                                            Dim * interface_nodes_.size()));
   else
     interface_velocity_ = interface_velocity;
 
@@ -370,7 +433,7 @@ FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::Mat
   const auto [alpha0, alpha1, alpha2, extrap] = bdf_coefficients(params_.scheme, accepted_, dt, dt_n_);
   s.dt = steady ? 0.0 : dt;
   s.alpha0_dt = steady ? 0.0 : alpha0 / dt;
-  s.mesh_velocity = Eigen::MatrixX2d::Zero(n, 2);
+  s.mesh_velocity = Nodes::Zero(n, Dim);
   if (!steady) s.mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
   s.U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
   // A later coupling iteration of the step starts its linear solve from the last iterate's
@@ -385,33 +448,42 @@ FlowSolver::Step FlowSolver::begin_step(double time, double dt, const Eigen::Mat
   s.constraints = strong_constraints(im.dof, im.dirichlet, im.symmetry, X_, time,
                                      im.pressure_vertex >= 0 ? im.dof.pressure(im.pressure_vertex) : -1,
                                      im.pressure_value ? im.pressure_value(time) : 0.0);
-  s.body = Eigen::MatrixX2d::Zero(n, 2);
+  s.body = Nodes::Zero(n, Dim);
   if (im.body_force)
     for (int i = 0; i < n; ++i) s.body.row(i) = im.body_force(X_.row(i).transpose(), time).transpose();
   return s;
 }
 
 // The system of one iteration about U_lin: volume terms, Nitsche terms, strong constraints.
-void FlowSolver::assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report) {
+template <int Dim>
+void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report) {
   auto& im = *impl_;
   const auto t_assembly = Clock::now();
-  const detail::AssemblyInput in{X_,      step.mesh_velocity, step.body, U_lin, step.history,
-                                 params_, step.alpha0_dt,     step.dt};
+  const detail::AssemblyInputT<Dim> in{X_,      step.mesh_velocity, step.body, U_lin, step.history,
+                                       params_, step.alpha0_dt,     step.dt};
   im.element->prepare(in);
   double bad = 0;
   if (const int e = im.assemble_volume(in, std::max(1, params_.threads), bad); e >= 0) {
     const auto& m = mesh();
-    const Eigen::RowVector2d centre =
-        (X_.row(m.triangles(e, 0)) + X_.row(m.triangles(e, 1)) + X_.row(m.triangles(e, 2))) / 3.0;
-    throw MeshTangled(
-        fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}) is {}; the mesh motion "
-                    "tangled the mesh",
-                    step.time, im.element->cell_name(), e, centre(0), centre(1), im.element->inverted(bad)));
+    if constexpr (Dim == 2) {
+      const Eigen::RowVector2d centre =
+          (X_.row(m.triangles(e, 0)) + X_.row(m.triangles(e, 1)) + X_.row(m.triangles(e, 2))) / 3.0;
+      throw MeshTangled(
+          fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}) is {}; the mesh motion "
+                      "tangled the mesh",
+                      step.time, im.element->cell_name(), e, centre(0), centre(1), im.element->inverted(bad)));
+    } else {
+      Eigen::RowVector3d centre = Eigen::RowVector3d::Zero();
+      for (int k = 0; k < 4; ++k) centre += X_.row(m.tets(e, k)) / 4.0;
+      throw MeshTangled(fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}, {:.5g}) is {}", step.time,
+                                    im.element->cell_name(), e, centre(0), centre(1), centre(2),
+                                    im.element->inverted(bad)));
+    }
   }
   std::copy(im.volume.valuePtr(), im.volume.valuePtr() + im.volume.nonZeros(), im.matrix.valuePtr());
   im.rhs = im.rhs_volume;
   // Nitsche terms on the interface.
-  const detail::NitscheInput nitsche{X_, X_n_, interface_velocity_, params_};
+  const detail::NitscheInputT<Dim> nitsche{X_, X_n_, interface_velocity_, params_};
   detail::LocalSystem s;
   for (const auto& edge : im.edges) {
     im.element->nitsche(edge, nitsche, s);
@@ -421,8 +493,9 @@ void FlowSolver::assemble(const Step& step, const Eigen::VectorXd& U_lin, StepRe
   report.assembly_seconds += seconds_since(t_assembly);
 }
 
-StepReport FlowSolver::solve(double time, double dt, const Eigen::MatrixX2d& positions,
-                             const Eigen::VectorXd& interface_velocity) {
+template <int Dim>
+StepReport BasicFlowSolver<Dim>::solve(double time, double dt, const Nodes& positions,
+                                       const Eigen::VectorXd& interface_velocity) {
   StepReport report;
   auto& im = *impl_;
   Step step = begin_step(time, dt, positions, interface_velocity);
@@ -433,7 +506,7 @@ StepReport FlowSolver::solve(double time, double dt, const Eigen::MatrixX2d& pos
     Eigen::VectorXd U_new =
         im.lu->solve(im.matrix, im.rhs, step.retrial ? U_ : U_lin, report,
                      fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration), step.alpha0_dt);
-    double change = relative_velocity_change(U_new, U_lin, mesh().node_count(), im.dof);
+    double change = relative_velocity_change<Dim>(U_new, U_lin, mesh().node_count(), im.dof);
     // Damped Newton (P2/P1): an update that grows the change is halved (iterations 3 on, so
     // the first Oseen/Stokes solve and the first Newton correction are always taken whole).
     if (im.element->damped_newton() && params_.newton && iteration >= 3 && change > previous_change) {
@@ -452,7 +525,8 @@ StepReport FlowSolver::solve(double time, double dt, const Eigen::MatrixX2d& pos
   return report;
 }
 
-void FlowSolver::accept() {
+template <int Dim>
+void BasicFlowSolver<Dim>::accept() {
   U_nm1_ = U_n_;
   U_n_ = U_;
   X_nm1_ = X_n_;
@@ -465,15 +539,16 @@ void FlowSolver::accept() {
 // Entries under `prefix`: element (text), u, u_n, u_nm1, reaction (every unknown), x, x_n,
 // x_nm1 (every node, column-major: all x then all y), dt_n, dt_trial, accepted_steps,
 // trial_solves, interface_velocity (2 per interface node); the linear solver's under "lu.".
-void FlowSolver::save_state(StateArchive& state, const std::string& prefix) {
+template <int Dim>
+void BasicFlowSolver<Dim>::save_state(StateArchive& state, const std::string& prefix) {
   state.put(prefix + "element", std::string(impl_->element->name()));
   state.put(prefix + "u", U_);
   state.put(prefix + "u_n", U_n_);
   state.put(prefix + "u_nm1", U_nm1_);
   state.put(prefix + "reaction", reaction_);
-  state.put(prefix + "x", flatten(X_));
-  state.put(prefix + "x_n", flatten(X_n_));
-  state.put(prefix + "x_nm1", flatten(X_nm1_));
+  state.put(prefix + "x", flatten<Dim>(X_));
+  state.put(prefix + "x_n", flatten<Dim>(X_n_));
+  state.put(prefix + "x_nm1", flatten<Dim>(X_nm1_));
   state.put(prefix + "dt_n", dt_n_);
   state.put(prefix + "dt_trial", dt_trial_);
   state.put(prefix + "accepted_steps", static_cast<std::int64_t>(accepted_));
@@ -486,7 +561,8 @@ void FlowSolver::save_state(StateArchive& state, const std::string& prefix) {
 // Reads every entry of the flow state before changing anything: a state that does not fit
 // (another element, mesh or interface) throws fsi::StateError naming the entry and leaves the
 // solver as it was; then the linear solver's entries.
-void FlowSolver::load_state(const StateArchive& state, const std::string& prefix) {
+template <int Dim>
+void BasicFlowSolver<Dim>::load_state(const StateArchive& state, const std::string& prefix) {
   const std::string element = impl_->element->name(), saved = state.text(prefix + "element");
   if (saved != element)
     throw StateError(
@@ -505,9 +581,9 @@ void FlowSolver::load_state(const StateArchive& state, const std::string& prefix
   U_n_ = std::move(U_n);
   U_nm1_ = std::move(U_nm1);
   reaction_ = std::move(reaction);
-  X_ = unflatten(X);
-  X_n_ = unflatten(X_n);
-  X_nm1_ = unflatten(X_nm1);
+  X_ = unflatten<Dim>(X);
+  X_n_ = unflatten<Dim>(X_n);
+  X_nm1_ = unflatten<Dim>(X_nm1);
   interface_velocity_ = std::move(iface);
   dt_n_ = dt_n;
   dt_trial_ = dt_trial;
@@ -516,57 +592,65 @@ void FlowSolver::load_state(const StateArchive& state, const std::string& prefix
   impl_->lu->load_state(state, prefix + "lu.");
 }
 
-TransferReport FlowSolver::transfer_state(const FlowSolver& old, const std::vector<int>& old_node) {
-  const auto& om = old.mesh();
-  const auto& nm = mesh();
-  const auto& od = old.impl_->dof;
-  const auto& nd = impl_->dof;
-  if (old_node.size() != static_cast<std::size_t>(nm.node_count()))
-    throw std::invalid_argument("FlowSolver::transfer_state: old_node has the wrong size");
-  // Old nodal fields: u_n, u_{n-1} (2 + 2 columns) and x_n - x_{n-1} (2) per node; p_n, p_{n-1} per vertex.
-  const int on = om.node_count(), ov = om.vertices();
-  Eigen::MatrixXd nodal(on, 6), vertex(ov, 2);
-  for (int i = 0; i < on; ++i)
-    for (int c = 0; c < 2; ++c) {
-      nodal(i, c) = old.U_n_(od.velocity(i, c));
-      nodal(i, 2 + c) = old.U_nm1_(od.velocity(i, c));
-      nodal(i, 4 + c) = old.X_n_(i, c) - old.X_nm1_(i, c);
-    }
-  for (int v = 0; v < ov; ++v) vertex(v, 0) = old.U_n_(od.pressure(v)), vertex(v, 1) = old.U_nm1_(od.pressure(v));
-  const MeshLocator locator(om, old.X_n_);
-  TransferReport report;
-  Eigen::MatrixXd at_nodes = interpolate_field(locator, om, nodal, nm.nodes, &report);
-  Eigen::MatrixXd at_vertices = interpolate_field(locator, om, vertex, nm.nodes.topRows(nm.vertices()));
-  // Kept nodes: their own values, not an interpolation.
-  for (int i = 0; i < nm.node_count(); ++i)
-    if (const int o = old_node[static_cast<std::size_t>(i)]; o >= 0) {
-      at_nodes.row(i) = nodal.row(o);
-      if (i < nm.vertices()) {
-        if (o >= ov) throw std::invalid_argument("FlowSolver::transfer_state: a vertex kept as a midpoint");
-        at_vertices.row(i) = vertex.row(o);
+template <int Dim>
+TransferReport BasicFlowSolver<Dim>::transfer_state(const BasicFlowSolver& old, const std::vector<int>& old_node) {
+  if constexpr (Dim == 3) {
+    (void)old;
+    (void)old_node;
+    throw std::invalid_argument("the 3D fluid cannot transfer a state between meshes yet");
+  } else {
+    const auto& om = old.mesh();
+    const auto& nm = mesh();
+    const auto& od = old.impl_->dof;
+    const auto& nd = impl_->dof;
+    if (old_node.size() != static_cast<std::size_t>(nm.node_count()))
+      throw std::invalid_argument("FlowSolver::transfer_state: old_node has the wrong size");
+    // Old nodal fields: u_n, u_{n-1} (2 + 2 columns) and x_n - x_{n-1} (2) per node; p_n, p_{n-1} per vertex.
+    const int on = om.node_count(), ov = om.vertices();
+    Eigen::MatrixXd nodal(on, 6), vertex(ov, 2);
+    for (int i = 0; i < on; ++i)
+      for (int c = 0; c < 2; ++c) {
+        nodal(i, c) = old.U_n_(od.velocity(i, c));
+        nodal(i, 2 + c) = old.U_nm1_(od.velocity(i, c));
+        nodal(i, 4 + c) = old.X_n_(i, c) - old.X_nm1_(i, c);
       }
-    }
-  U_n_ = U_nm1_ = Eigen::VectorXd::Zero(nd.dofs);
-  for (int i = 0; i < nm.node_count(); ++i)
-    for (int c = 0; c < 2; ++c) {
-      U_n_(nd.velocity(i, c)) = at_nodes(i, c);
-      U_nm1_(nd.velocity(i, c)) = at_nodes(i, 2 + c);
-    }
-  for (int v = 0; v < nm.vertices(); ++v)
-    U_n_(nd.pressure(v)) = at_vertices(v, 0), U_nm1_(nd.pressure(v)) = at_vertices(v, 1);
-  U_ = U_n_;
-  reaction_ = Eigen::VectorXd::Zero(nd.dofs);
-  X_ = X_n_ = nm.nodes;
-  X_nm1_ = nm.nodes - at_nodes.rightCols<2>();
-  dt_n_ = old.dt_n_;
-  dt_trial_ = old.dt_trial_;
-  accepted_ = old.accepted_;
-  trial_solves_ = 0;
-  if (interface_velocity_.size() == old.interface_velocity_.size()) interface_velocity_ = old.interface_velocity_;
-  return report;
+    for (int v = 0; v < ov; ++v) vertex(v, 0) = old.U_n_(od.pressure(v)), vertex(v, 1) = old.U_nm1_(od.pressure(v));
+    const MeshLocator locator(om, old.X_n_);
+    TransferReport report;
+    Eigen::MatrixXd at_nodes = interpolate_field(locator, om, nodal, nm.nodes, &report);
+    Eigen::MatrixXd at_vertices = interpolate_field(locator, om, vertex, nm.nodes.topRows(nm.vertices()));
+    // Kept nodes: their own values, not an interpolation.
+    for (int i = 0; i < nm.node_count(); ++i)
+      if (const int o = old_node[static_cast<std::size_t>(i)]; o >= 0) {
+        at_nodes.row(i) = nodal.row(o);
+        if (i < nm.vertices()) {
+          if (o >= ov) throw std::invalid_argument("FlowSolver::transfer_state: a vertex kept as a midpoint");
+          at_vertices.row(i) = vertex.row(o);
+        }
+      }
+    U_n_ = U_nm1_ = Eigen::VectorXd::Zero(nd.dofs);
+    for (int i = 0; i < nm.node_count(); ++i)
+      for (int c = 0; c < 2; ++c) {
+        U_n_(nd.velocity(i, c)) = at_nodes(i, c);
+        U_nm1_(nd.velocity(i, c)) = at_nodes(i, 2 + c);
+      }
+    for (int v = 0; v < nm.vertices(); ++v)
+      U_n_(nd.pressure(v)) = at_vertices(v, 0), U_nm1_(nd.pressure(v)) = at_vertices(v, 1);
+    U_ = U_n_;
+    reaction_ = Eigen::VectorXd::Zero(nd.dofs);
+    X_ = X_n_ = nm.nodes;
+    X_nm1_ = nm.nodes - at_nodes.rightCols<2>();
+    dt_n_ = old.dt_n_;
+    dt_trial_ = old.dt_trial_;
+    accepted_ = old.accepted_;
+    trial_solves_ = 0;
+    if (interface_velocity_.size() == old.interface_velocity_.size()) interface_velocity_ = old.interface_velocity_;
+    return report;
+  }
 }
 
-void FlowSolver::restart_history() {
+template <int Dim>
+void BasicFlowSolver<Dim>::restart_history() {
   U_nm1_ = U_ = U_n_;
   X_nm1_ = X_ = X_n_;
   dt_n_ = dt_trial_ = 0;
@@ -574,44 +658,54 @@ void FlowSolver::restart_history() {
   interface_velocity_.setZero();
 }
 
-Eigen::MatrixX2d FlowSolver::velocity() const {
-  Eigen::MatrixX2d v(mesh().node_count(), 2);
+template <int Dim>
+typename BasicFlowSolver<Dim>::Nodes BasicFlowSolver<Dim>::velocity() const {
+  Nodes v(mesh().node_count(), Dim);
   for (int i = 0; i < mesh().node_count(); ++i)
-    v.row(i) << U_(impl_->dof.velocity(i, 0)), U_(impl_->dof.velocity(i, 1));
+    for (int c = 0; c < Dim; ++c) v(i, c) = U_(impl_->dof.velocity(i, c));
   return v;
 }
 
-Eigen::VectorXd FlowSolver::pressure() const { return impl_->element->nodal_pressure(U_); }
+template <int Dim>
+Eigen::VectorXd BasicFlowSolver<Dim>::pressure() const {
+  return impl_->element->nodal_pressure(U_);
+}
 
-Eigen::Vector2d FlowSolver::force(const std::vector<std::string>& groups) const {
-  Eigen::Vector2d f = Eigen::Vector2d::Zero();
-  for (int node : mesh().boundary_nodes(groups)) f -= reaction_.segment<2>(impl_->dof.velocity(node, 0));
+template <int Dim>
+typename BasicFlowSolver<Dim>::PointD BasicFlowSolver<Dim>::force(const std::vector<std::string>& groups) const {
+  PointD f = PointD::Zero();
+  for (int node : mesh().boundary_nodes(groups)) f -= reaction_.template segment<Dim>(impl_->dof.velocity(node, 0));
   return f;
 }
 
-Eigen::SparseMatrix<double> FlowSolver::interface_mass() const {
+template <int Dim>
+Eigen::SparseMatrix<double> BasicFlowSolver<Dim>::interface_mass() const {
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(9 * impl_->edges.size());
-  const Eigen::MatrixX2d& X = params_.penalty_on_step_start ? X_n_ : X_;
+  const Nodes& X = params_.penalty_on_step_start ? X_n_ : X_;
   for (const auto& edge : impl_->edges) impl_->element->interface_mass(edge, X, t);
   Eigen::SparseMatrix<double> m(n, n);
   m.setFromTriplets(t.begin(), t.end());
   return m;
 }
 
-Eigen::VectorXd FlowSolver::interface_velocity_integral() const {
-  Eigen::VectorXd vf(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
+template <int Dim>
+Eigen::VectorXd BasicFlowSolver<Dim>::interface_velocity_integral() const {
+  Eigen::VectorXd vf(Dim * static_cast<Eigen::Index>(interface_nodes_.size()));
   for (std::size_t i = 0; i < interface_nodes_.size(); ++i)
-    vf.segment<2>(2 * static_cast<Eigen::Index>(i)) = U_.segment<2>(impl_->dof.velocity(interface_nodes_[i], 0));
+    vf.template segment<Dim>(Dim * static_cast<Eigen::Index>(i)) =
+        U_.template segment<Dim>(impl_->dof.velocity(interface_nodes_[i], 0));
   return apply_nodal(interface_mass(), vf);  // f_v = M_f v_f, the penalty term's own operator
 }
 
-Eigen::VectorXd FlowSolver::interface_traction() const {
+template <int Dim>
+Eigen::VectorXd BasicFlowSolver<Dim>::interface_traction() const {
   const Eigen::Index ni = static_cast<Eigen::Index>(interface_nodes_.size());
-  Eigen::VectorXd f(2 * ni);
+  Eigen::VectorXd f(Dim * ni);
   for (Eigen::Index i = 0; i < ni; ++i)
-    f.segment<2>(2 * i) = reaction_.segment<2>(impl_->dof.velocity(interface_nodes_[static_cast<std::size_t>(i)], 0));
+    f.template segment<Dim>(Dim * i) =
+        reaction_.template segment<Dim>(impl_->dof.velocity(interface_nodes_[static_cast<std::size_t>(i)], 0));
   // + gamma_N1 int N^T (v_f - v_s) = gamma_N1 (f_v - M_f v_s)
   return f +
          params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));
@@ -619,15 +713,25 @@ Eigen::VectorXd FlowSolver::interface_traction() const {
 
 // The vertex triangle holding `point` (at the positions of the last solve), with barycentric
 // coordinates; false when the point is outside (by more than round-off).
-bool FlowSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const {
+template <int Dim>
+bool BasicFlowSolver<Dim>::locate(const PointD& point, int& element, Eigen::Matrix<double, Dim + 1, 1>& bary) const {
   const auto& m = mesh();
   double best = -std::numeric_limits<double>::infinity();
-  for (int e = 0; e < m.triangle_count(); ++e) {
-    const Eigen::Vector2d a = X_.row(m.triangles(e, 0)), b = X_.row(m.triangles(e, 1)), c = X_.row(m.triangles(e, 2));
-    Eigen::Matrix2d J;
-    J << b - a, c - a;
-    const Eigen::Vector2d s = J.inverse() * (point - a);
-    const Eigen::Vector3d l(1 - s(0) - s(1), s(0), s(1));
+  for (int e = 0; e < m.cell_count(); ++e) {
+    Eigen::Matrix<double, Dim + 1, 1> l;
+    if constexpr (Dim == 2) {
+      const Eigen::Vector2d a = X_.row(m.triangles(e, 0)), b = X_.row(m.triangles(e, 1)), c = X_.row(m.triangles(e, 2));
+      Eigen::Matrix2d J;
+      J << b - a, c - a;
+      const Eigen::Vector2d s = J.inverse() * (point - a);
+      l << 1 - s(0) - s(1), s(0), s(1);
+    } else {
+      const Eigen::Vector3d a = X_.row(m.tets(e, 0));
+      Eigen::Matrix3d J;
+      for (int k = 0; k < 3; ++k) J.col(k) = X_.row(m.tets(e, k + 1)).transpose() - a;
+      const Eigen::Vector3d s = J.inverse() * (point - a);
+      l << 1 - s.sum(), s(0), s(1), s(2);
+    }
     const double worst = l.minCoeff();
     if (worst > best) {
       best = worst;
@@ -639,20 +743,30 @@ bool FlowSolver::locate(const Eigen::Vector2d& point, int& element, Eigen::Vecto
   return best > -1e-9;
 }
 
-double FlowSolver::pressure_at(const Eigen::Vector2d& point) const {
+template <int Dim>
+double BasicFlowSolver<Dim>::pressure_at(const PointD& point) const {
   int e = 0;
-  Eigen::Vector3d l;
+  Eigen::Matrix<double, Dim + 1, 1> l;
   if (!locate(point, e, l)) return std::numeric_limits<double>::quiet_NaN();
   double p = 0;
-  for (int k = 0; k < 3; ++k) p += l(k) * U_(impl_->dof.pressure(mesh().triangles(e, k)));
+  for (int k = 0; k < Dim + 1; ++k) {
+    if constexpr (Dim == 2)
+      p += l(k) * U_(impl_->dof.pressure(mesh().triangles(e, k)));
+    else
+      p += l(k) * U_(impl_->dof.pressure(mesh().tets(e, k)));
+  }
   return p;
 }
 
-Eigen::Vector2d FlowSolver::velocity_at(const Eigen::Vector2d& point) const {
+template <int Dim>
+typename BasicFlowSolver<Dim>::PointD BasicFlowSolver<Dim>::velocity_at(const PointD& point) const {
   int e = 0;
-  Eigen::Vector3d l;
-  if (!locate(point, e, l)) return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Matrix<double, Dim + 1, 1> l;
+  if (!locate(point, e, l)) return PointD::Constant(std::numeric_limits<double>::quiet_NaN());
   return impl_->element->velocity_at(e, l, U_);
 }
+
+template class BasicFlowSolver<2>;
+template class BasicFlowSolver<3>;
 
 }  // namespace fsi::fluid

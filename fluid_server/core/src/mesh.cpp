@@ -40,6 +40,9 @@ Eigen::Matrix<int, 6, 1> FluidMesh::element_nodes6(int e) const {
 }
 
 FluidMesh FluidMesh::from_gmsh(const GmshMesh& mesh, const std::vector<std::string>& domain_groups) {
+  if (mesh.has_volume())
+    throw std::runtime_error(
+        fmt::format("{}: a 3D mesh (tetrahedra) for a 2D fluid (set fluid.dimension: 3)", mesh.source.string()));
   std::vector<const GmshGroup*> cells;
   int cell_type = 0;
   for (const auto& g : mesh.groups) {

@@ -64,7 +64,7 @@ std::filesystem::path mesh_cache(const schema::Reader& mesh_section) {
 
 // The .msh file: fluid.mesh.file, or fluid.mesh.geo meshed by gmsh (cached) with the size h,
 // the further parameters and the element order.
-std::filesystem::path mesh_file(const schema::Reader& mesh_section, int order) {
+std::filesystem::path mesh_file(const schema::Reader& mesh_section, int order, int dimension = 2) {
   if (mesh_section.has("file")) return mesh_section.path("file");
   const auto geo = mesh_section.path("geo");
   std::map<std::string, double> parameters;
@@ -72,7 +72,7 @@ std::filesystem::path mesh_file(const schema::Reader& mesh_section, int order) {
   (void)mesh_section.declared("parameters");
   if (auto extra = mesh_section.section().optional_child("parameters"))
     for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
-  return mesh_geo(geo, parameters, mesh_cache(mesh_section), order);
+  return mesh_geo(geo, parameters, mesh_cache(mesh_section), order, dimension);
 }
 
 // The mesh of `msh` in the element's order (P2/P1: a linear mesh gets straight midpoints).
@@ -258,9 +258,10 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
 }  // namespace
 
 std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
-                               const std::filesystem::path& cache_dir, int order) {
+                               const std::filesystem::path& cache_dir, int order, int dimension) {
   std::string key = read_text(geo);
   if (order != 1) key += fmt::format("\norder={}", order);
+  if (dimension != 2) key += fmt::format("\ndimension={}", dimension);
   for (const auto& [name, value] : parameters) key += fmt::format("\n{}={:.17g}", name, value);
   const auto hash = std::hash<std::string>{}(key);
   std::filesystem::create_directories(cache_dir);
@@ -268,7 +269,7 @@ std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<
   if (std::filesystem::exists(out)) return out;
   const auto tmp = cache_dir / fmt::format("{}_{:016x}.{}.tmp.msh", geo.stem().string(), hash, ::getpid());
   const auto log_file = cache_dir / fmt::format("{}_{:016x}.log", geo.stem().string(), hash);
-  std::string cmd = "gmsh -2 -format msh22 -v 2";
+  std::string cmd = fmt::format("gmsh -{} -format msh22 -v 2", dimension);
   if (order != 1) cmd += fmt::format(" -order {}", order);
   for (const auto& [name, value] : parameters) cmd += fmt::format(" -setnumber {} {:.17g}", name, value);
   cmd += fmt::format(" '{}' -o '{}' > '{}' 2>&1", geo.string(), tmp.string(), log_file.string());
@@ -293,6 +294,7 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
   const schema::Reader section(fluid_section, navier_stokes_keys());
   setup_ = setup;
   element_ = section.get<std::string>("element");
+  if (section.get<std::string>("dimension") == "3") return configure3(section);
   const bool taylor_hood = element_ == "p2p1";
   const auto mesh_section = section.child("mesh");
   const auto msh = mesh_file(mesh_section, taylor_hood ? 2 : 1);
@@ -324,6 +326,127 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
       solver_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard",
       solver_->interface_nodes().size(), msh.string());
   start_ = last_log_ = std::chrono::steady_clock::now();
+}
+
+// fluid.dimension 3: tetrahedra, Taylor-Hood P2/P1 through the same FlowSolver (BasicFlowSolver<3>).
+// Inflow profiles: uniform, or parabolic in both directions across the inlet's bounding box
+// (DFG 3D: 16 U y z (H - y)(H - z) / H^4); walls; outlets; symmetry planes; force and pressure probes.
+void NavierStokesFluid::configure3(const schema::Reader& section) {
+  if (element_ != "p2p1") section.fail("element", "the 3D fluid is Taylor-Hood: set fluid.element: p2p1");
+  if (section.has("interface")) section.fail("dimension", "the 3D fluid runs alone (no coupling interface yet)");
+  const auto mesh_section = section.child("mesh");
+  const auto msh = mesh_file(mesh_section, 2, 3);
+  TetMesh mesh;
+  try {
+    mesh = TetMesh::from_gmsh(read_gmsh(msh), mesh_section.get_or<std::vector<std::string>>("domain", {}));
+  } catch (const std::exception& e) {
+    mesh_section.fail(mesh_section.has("file") ? "file" : "geo", e.what());
+  }
+  FlowParameters params;
+  read_physics(section, true, params);
+  read_stabilisation(section, true, params.stabilisation);
+  if (params.stabilisation.supg) section.fail("stabilisation", "the 3D fluid has no SUPG (grad-div only)");
+  read_linear_solver(section, true, params);
+  solver3_ = std::make_unique<FlowSolver3>(std::move(mesh), params, element_);
+  const auto& m = solver3_->mesh();
+  auto vec3 = [](const std::vector<double>& v, const schema::Reader& where, const std::string& key) {
+    if (v.size() != 3) where.fail(key, fmt::format("a 3D scene needs [x, y, z], got {} numbers", v.size()));
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  };
+  for (const auto& inflow : section.list("inflow")) {
+    const auto group = inflow.get<std::string>("group");
+    if (!m.has_boundary(group)) inflow.fail("group", "no boundary group '" + group + "' in " + msh.string());
+    const Eigen::Vector3d direction =
+        vec3(inflow.get<std::vector<double>>("direction"), inflow, "direction").normalized();
+    const bool parabolic = inflow.get<std::string>("profile") == "parabolic";
+    const double umax = inflow.has("max_velocity") ? inflow.get<double>("max_velocity")
+                                                   : (parabolic ? 2.25 : 1.0) * inflow.get<double>("mean_velocity");
+    const double ramp = inflow.get<double>("ramp_time");
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    for (int n : m.boundary_nodes({group})) {
+      lo = lo.cwiseMin(m.nodes.row(n).transpose());
+      hi = hi.cwiseMax(m.nodes.row(n).transpose());
+    }
+    solver3_->add_dirichlet(group, [=](const Eigen::Vector3d& x, double t) -> Eigen::Vector3d {
+      double shape = 1;
+      if (parabolic)
+        for (int c = 0; c < 3; ++c)
+          if (hi(c) - lo(c) > 1e-12 * (hi - lo).norm()) {
+            const double s = std::clamp((x(c) - lo(c)) / (hi(c) - lo(c)), 0.0, 1.0);
+            shape *= 4 * s * (1 - s);
+          }
+      const double factor = (ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0;
+      return umax * factor * shape * direction;
+    });
+  }
+  for (const auto& g : string_list(section, "walls")) {
+    if (!m.has_boundary(g)) section.fail("walls", "no boundary group '" + g + "' in " + msh.string());
+    solver3_->add_dirichlet(g, [](const Eigen::Vector3d&, double) { return Eigen::Vector3d::Zero(); });
+  }
+  for (const auto& g : string_list(section, "symmetry")) {
+    if (!m.has_boundary(g)) section.fail("symmetry", "no boundary group '" + g + "' in " + msh.string());
+    solver3_->add_symmetry(g);
+  }
+  for (const auto& g : string_list(section, "outlet"))
+    if (!m.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh.string());
+  if (section.list("moving_walls").size() > 0) section.fail("moving_walls", "not in 3D yet");
+  if (auto pr = section.optional_child("pressure_reference"))
+    solver3_->set_pressure_reference(vec3(pr->get<std::vector<double>>("point"), *pr, "point"),
+                                     [v = pr->get<double>("value")](double) { return v; });
+  for (const auto& f : section.list("forces")) {
+    ForceProbe probe;
+    probe.name = f.get<std::string>("name");
+    probe.groups = f.get<std::vector<std::string>>("groups");
+    for (const auto& g : probe.groups)
+      if (!m.has_boundary(g)) f.fail("groups", "no boundary group '" + g + "'");
+    if (f.has("reference_velocity")) {
+      const double u = f.get<double>("reference_velocity"), l = f.get<double>("reference_length");
+      probe.coefficient_scale = 2.0 / (params.density * u * u * l);  // DFG 3D: l = D H (an area)
+    }
+    forces_.push_back(probe);
+  }
+  (void)section.declared("pressure_probes");
+  (void)section.declared("pressure_differences");
+  if (auto pp = section.section().optional_child("pressure_probes"))
+    for (const auto& k : pp->keys()) {
+      const auto v = pp->get<std::vector<double>>(k);
+      if (v.size() != 3) pp->fail(k, fmt::format("a 3D scene needs [x, y, z], got {} numbers", v.size()));
+      pressure_probes3_.push_back({k, Eigen::Vector3d(v[0], v[1], v[2])});
+    }
+  if (auto pd = section.section().optional_child("pressure_differences"))
+    for (const auto& k : pd->keys()) {
+      const auto pair = pd->get<std::vector<std::string>>(k);
+      for (const auto& p : pair)
+        if (std::none_of(pressure_probes3_.begin(), pressure_probes3_.end(),
+                         [&](const auto& q) { return q.first == p; }))
+          pd->fail(k, "unknown pressure probe '" + p + "'");
+      pressure_differences_.push_back({k, {pair[0], pair[1]}});
+    }
+  fsi::logger("fluid")->info(
+      "fluid: 3D p2p1 (Taylor-Hood), {} nodes, {} tetrahedra, {} unknowns, scheme {}, {}, mesh {}", m.node_count(),
+      m.cell_count(), solver3_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard", msh.string());
+  start_ = last_log_ = std::chrono::steady_clock::now();
+}
+
+std::map<std::string, double> NavierStokesFluid::probes3() {
+  std::map<std::string, double> probes;
+  for (const auto& f : forces_) {
+    const Eigen::Vector3d force = solver3_->force(f.groups);
+    const std::string prefix = f.name.empty() ? "" : f.name + "_";
+    probes[prefix + "drag"] = force.x();
+    probes[prefix + "lift"] = force.y();
+    probes[prefix + "side"] = force.z();
+    if (f.coefficient_scale > 0) {
+      probes[prefix + "cd"] = f.coefficient_scale * force.x();
+      probes[prefix + "cl"] = f.coefficient_scale * force.y();
+    }
+  }
+  for (const auto& [name, point] : pressure_probes3_) probes[name] = solver3_->pressure_at(point);
+  for (const auto& [name, pair] : pressure_differences_) probes[name] = probes.at(pair.first) - probes.at(pair.second);
+  probes["nonlinear_iterations"] = last_report_.iterations;
+  probes["nonlinear_change"] = last_report_.change;
+  probes["factorisations"] = factorisations_;
+  return probes;
 }
 
 // fluid.inflow, walls, moving_walls, symmetry, outlet and pressure_reference on the solver.
@@ -670,6 +793,7 @@ Eigen::MatrixX2d NavierStokesFluid::extend(const Eigen::VectorXd& interface_disp
 
 InterfaceMeshData NavierStokesFluid::interface() const {
   InterfaceMeshData data;
+  if (solver3_) return data;
   const auto& nodes = solver_->interface_nodes();
   data.coordinates.resize(static_cast<Eigen::Index>(nodes.size()), 2);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
@@ -683,6 +807,7 @@ InterfaceMeshData NavierStokesFluid::interface() const {
 
 FluidLoads NavierStokesFluid::initial_loads(const Eigen::VectorXd&, const Eigen::VectorXd&) {
   FluidLoads loads;
+  if (solver3_) return loads;
   loads.traction_force = solver_->interface_traction();
   loads.velocity_integral = solver_->interface_velocity_integral();
   loads.interface_mass = solver_->interface_mass();
@@ -711,6 +836,22 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
     return fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration,
                        e.what());
   };
+  if (solver3_) {
+    try {
+      last_report_ = solver3_->solve(info.time, info.dt, solver3_->mesh().nodes, {});
+    } catch (const SolverError& e) {
+      throw SolverError(where(e));
+    }
+    solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++solves_;
+    factorisations_ += last_report_.factorisations;
+    assembly_seconds_ += last_report_.assembly_seconds;
+    factor_seconds_ += last_report_.factor_seconds;
+    linear_solve_seconds_ += last_report_.solve_seconds;
+    FluidLoads loads;
+    loads.nonlinear_iterations = last_report_.iterations;
+    return loads;
+  }
   try {
     try {
       solve_on_mesh(info, interface_displacement, interface_velocity);
@@ -754,6 +895,10 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
 }
 
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
+  if (solver3_) {
+    solver3_->accept();
+    return probes3();
+  }
   solver_->accept();
   if (motion_ && last_interface_displacement_.size() > 0) motion_->accept(motion_input(last_interface_displacement_));
   accepted_interface_displacement_ = last_interface_displacement_;
@@ -821,6 +966,7 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
 }
 
 void NavierStokesFluid::save_state(StateArchive& state) {
+  if (solver3_) return solver3_->save_state(state, "flow.");
   if (!solver_) throw std::logic_error("NavierStokesFluid::save_state before configure()");
   solver_->save_state(state, "flow.");
   if (motion_) motion_->save_state(state, "mesh.");
@@ -831,6 +977,7 @@ void NavierStokesFluid::save_state(StateArchive& state) {
 }
 
 void NavierStokesFluid::load_state(const StateArchive& state) {
+  if (solver3_) return solver3_->load_state(state, "flow.");
   if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
   if (const auto saved = state.text("flow.element"); saved != element_)
     throw StateError(
@@ -857,6 +1004,7 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
 }
 
 std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {
+  if (solver3_) return {};  // no VTK tetrahedra yet
   if (vtk_every_ == 0 || setup_.output_dir.empty() || (vtk_every_ > 0 && info.step % vtk_every_ != 0)) return {};
   const auto mesh = solver_->mesh().linear_refinement();  // P2: 4 linear triangles per element
   VtkGrid grid;

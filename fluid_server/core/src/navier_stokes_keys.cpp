@@ -9,6 +9,10 @@ const std::vector<schema::Key>& navier_stokes_keys() {
   const std::string element = "fluid.element";
   static const std::vector<Key> keys = {
       choice("element", {"p1p1", "p2p1"}, "P1/P1 with SUPG/PSPG, or isoparametric Taylor-Hood P2/P1").def("p1p1"),
+      choice("dimension", {"2", "3"},
+             "2: triangles; 3: tetrahedra (p2p1, steady or BDF, fluid alone: no interface yet; points and "
+             "directions [x, y, z])")
+          .def("2"),
       section("mesh", "the fluid mesh: a gmsh .msh file, or a .geo meshed by gmsh (cached)",
               {
                   text("file", "gmsh .msh, relative to the scene file (or the working folder, or configs/)")
@@ -113,7 +117,7 @@ const std::vector<schema::Key>& navier_stokes_keys() {
               choice("profile", {"parabolic", "uniform"}, "velocity profile").def("parabolic"),
               number("max_velocity", "peak velocity").group("velocity").in_unit("m/s"),
               number("mean_velocity", "mean velocity (parabolic: peak = 1.5 mean)").group("velocity").in_unit("m/s"),
-              vector2("direction", "flow direction").def("[1, 0]"),
+              vector2("direction", "flow direction ([x, y, z] in 3D)").def("[1, 0]").count(3),
               number("ramp_time", "(1 - cos) ramp from 0").def("0").in_unit("s"),
               point_pair("profile_extent", "[[x0, y0], [x1, y1]]: ends of the full profile").in_unit("m"),
               section("pulsation", "factor mean + amplitude sin(2 pi frequency t)",
@@ -147,7 +151,8 @@ const std::vector<schema::Key>& navier_stokes_keys() {
               number("reference_length", "reference length").req().only_when("reference_velocity").in_unit("m"),
           })
           .def("[]"),
-      named_map("pressure_probes", "pressure at points, name: [x, y]", vector2("<name>", "point").in_unit("m")),
+      named_map("pressure_probes", "pressure at points, name: [x, y] ([x, y, z] in 3D)",
+                vector2("<name>", "point").in_unit("m").count(3)),
       named_map("pressure_differences", "name: [high, low] (two pressure probes)",
                 string_list("<name>", "two pressure probe names").count(2)),
       section("output", "fluid output",

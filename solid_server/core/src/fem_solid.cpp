@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <set>
 
+#include "fsi/common/interface_geometry.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/scene_reader.hpp"
 #include "fsi/solid/element.hpp"
@@ -18,21 +19,10 @@ namespace fsi::solid {
 
 namespace {
 
-// A vector key of the mesh's dimension (fem_solid_keys.cpp's vector_key): [x, y] or [x, y, z];
-// absent: zero.
+// A vector key of the mesh's dimension ([x, y] or [x, y, z], checked by the reader); absent: zero.
 Eigen::VectorXd vec(const schema::Reader& s, const std::string& key, int dim) {
   if (!s.has(key)) return Eigen::VectorXd::Zero(dim);
-  std::vector<double> v;
-  try {
-    v = s.section().get<std::vector<double>>(key);
-  } catch (const ConfigError&) {
-    s.fail(key, fmt::format("must be a list of {} numbers", dim));
-  }
-  if (static_cast<int>(v.size()) != dim)
-    s.fail(key, fmt::format("has {} components, the mesh is {}D: give {}", v.size(), dim,
-                            dim == 2 ? "[x, y]" : "[x, y, z]"));
-  for (double x : v)
-    if (!std::isfinite(x)) s.fail(key, "must be finite");
+  const std::vector<double> v = s.vector(key, dim);
   return Eigen::Map<const Eigen::VectorXd>(v.data(), dim);
 }
 
@@ -214,8 +204,6 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
 
   // 7. Interface: named edges -> InterfaceMeshData; Algorithm 2 damping on them.
   const auto iface = s.names("interface");
-  if (dim == 3 && !iface.empty())
-    s.fail("interface", "coupling faces of a 3D solid mesh are not supported yet (run it standalone)");
   std::vector<Facet> iface_edges;
   try {
     iface_edges = mesh_.facets(iface);
@@ -226,29 +214,41 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   std::map<int, int> local;
   for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
   interface_ = {};
-  interface_.coordinates.resize(static_cast<Eigen::Index>(interface_nodes_.size()), 2);
+  interface_.dimension = dim;
+  interface_.coordinates.resize(static_cast<Eigen::Index>(interface_nodes_.size()), dim);
   interface_.lumped_measure = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
   for (std::size_t i = 0; i < interface_nodes_.size(); ++i) {
     interface_.node_ids.push_back(interface_nodes_[i]);
     interface_.coordinates.row(static_cast<Eigen::Index>(i)) = mesh_.nodes.row(interface_nodes_[i]);
   }
-  for (const auto& e : iface_edges) {
-    const int a = local[e[0]], b = local[e[1]];
-    interface_.segments.push_back({a, b});
-    const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
-    interface_.lumped_measure(a) += 0.5 * L;
-    interface_.lumped_measure(b) += 0.5 * L;
+  if (dim == 2) {
+    for (const auto& e : iface_edges) {
+      const int a = local[e[0]], b = local[e[1]];
+      interface_.segments.push_back({a, b});
+      const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
+      interface_.lumped_measure(a) += 0.5 * L;
+      interface_.lumped_measure(b) += 0.5 * L;
+    }
+  } else {  // the boundary quadrilaterals of the named face sets, bilinear faces of the interface
+    for (const auto& f : iface_edges) {
+      InterfaceFace face;
+      for (int v : f) face.nodes.push_back(local[v]);
+      interface_.faces.push_back(face);
+    }
+    if (!interface_.faces.empty()) interface_.lumped_measure = lumped_interface_measure(interface_);
   }
   // The solid's mass over its interface measure (the automatic Robin parameter's m_s / |Gamma|):
-  // the consistent mass matrix sums to 2 rho |Omega_s| (two components).
+  // the consistent mass matrix sums to dim rho |Omega_s| (one per component).
   if (interface_.lumped_measure.sum() > 0)
-    interface_.mass_per_area = 0.5 *
-                               Eigen::VectorXd(system_->mass() * Eigen::VectorXd::Ones(system_->mass().cols())).sum() /
-                               interface_.lumped_measure.sum();
+    interface_.mass_per_area = Eigen::VectorXd(system_->mass() * Eigen::VectorXd::Ones(system_->mass().cols())).sum() /
+                               dim / interface_.lumped_measure.sum();
   if (setup.interface_damping < 0) throw ConfigError("interface damping gamma_N1 must be >= 0");
   if (setup.interface_damping > 0) {
     if (iface_edges.empty()) s.fail("interface", "is required when the coupler asks for interface damping");
-    system_->set_damping(system_->boundary_mass(iface_edges, setup.interface_damping));
+    if (dim == 2)
+      system_->set_damping(system_->boundary_mass(iface_edges, setup.interface_damping));
+    else  // int N^T N on the faces (the coupler's M_G replaces it when it sends one)
+      set_interface_mass(nodal_interface_mass(interface_, Eigen::VectorXd()));
   }
 
   // 8. Probes: displacement of named points, interpolated in the cell that holds them.

@@ -4,15 +4,6 @@
 
 namespace fsi::solid {
 
-namespace {
-// A vector of the mesh's dimension, [x, y] or [x, y, z]. The scene schema's [x, y] type takes 2
-// numbers only (for now), so this declares a plain list and fem_solid.cpp's vec() checks the
-// count against the mesh where it reads the key.
-schema::Key vector_key(std::string name, std::string meaning) {
-  return schema::string_list(std::move(name), std::move(meaning) + "; [x, y] or [x, y, z] as the mesh");
-}
-}  // namespace
-
 const std::vector<schema::Key>& fem_solid_keys() {
   using namespace schema;
   static const std::vector<Key> keys = {
@@ -22,11 +13,8 @@ const std::vector<schema::Key>& fem_solid_keys() {
               choice("type", {"rectangle", "box", "gmsh"},
                      "built-in structured Q4 rectangle (2D), Hex8 box (3D), or a gmsh .msh file (2D)")
                   .req(),
-              vector_key("origin", "lower-left (back) corner")
-                  .req()
-                  .only_when("type", {"rectangle", "box"})
-                  .in_unit("m"),
-              vector_key("size", "lx, ly (, lz) (positive)").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
+              vector("origin", "lower-left (back) corner").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
+              vector("size", "lx, ly (, lz) (positive)").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
               int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
                   .req()
                   .only_when("type", {"rectangle"}),
@@ -51,7 +39,7 @@ const std::vector<schema::Key>& fem_solid_keys() {
              "3D: trilinear Hex8, or Hex8 with 9 enhanced strain modes")
           .def_computed("q4 (2D), hex8 (3D)"),
       number("density", "rho_s, reference configuration").req().gt(0).in_unit("kg/m^3"),
-      vector_key("gravity", "body force per unit mass").def_computed("0 (every component)").in_unit("m/s^2"),
+      vector("gravity", "body force per unit mass").def_computed("0 (every component)").in_unit("m/s^2"),
       choice("analysis", {"static", "dynamic"}, "equilibrium every step, or dynamics").def("dynamic"),
       choice("time_scheme", {"bdf1", "bdf2", "newmark"},
              "dynamic analysis: BDF1 (the paper), BDF2 or Newmark "
@@ -72,23 +60,24 @@ const std::vector<schema::Key>& fem_solid_keys() {
                        names("fixed", "the components held: x, y (, z)").req(),
                    })
           .def("[]"),
-      names("interface", "edge set(s) on the fluid side (coupling, Algorithm 2 damping)").def("none"),
+      names("interface", "facet set(s) on the fluid side (edges in 2D, faces in 3D; coupling, Algorithm 2 damping)")
+          .def("none"),
       section_list("tractions", "dead edge loads",
                    {
                        names("boundary", "facet set(s)").req(),
-                       vector_key("traction", "force per reference length (2D) or area (3D)").req().in_unit("N/m"),
+                       vector("traction", "force per reference length (2D) or area (3D)").req().in_unit("N/m"),
                    })
           .def("[]"),
       section_list("point_loads", "dead loads at the node nearest to a point",
                    {
-                       vector_key("point", "where").req().in_unit("m"),
-                       vector_key("force", "the load").req().in_unit("N"),
+                       vector("point", "where").req().in_unit("m"),
+                       vector("force", "the load").req().in_unit("N"),
                    })
           .def("[]"),
       section_list("probes", "displacement of points (probes NAME_x, NAME_y, and NAME_z in 3D)",
                    {
                        text("name", "probe name").req(),
-                       vector_key("point", "a point inside the mesh").req().in_unit("m"),
+                       vector("point", "a point inside the mesh").req().in_unit("m"),
                    })
           .def("[]"),
       integer("output_every", "VTK when the run writes output (time.output_every) and step % N == 0; 0 = never")

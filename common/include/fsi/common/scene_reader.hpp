@@ -40,6 +40,9 @@ class Reader {
   T get_or(const std::string& name, const T& fallback) const;
   // [x, y], or x (y = 0) for NumberOrVector2; absent: the declared default.
   std::array<double, 2> vector2(const std::string& name) const;
+  // A Vector or NumberOrVector key with `dim` components (2 or 3): a number x gives
+  // [x, 0(, 0)]; a list of another length is a ConfigError naming the dimension.
+  std::vector<double> vector(const std::string& name, int dim) const;
   // A Names key: one name or a list; absent: the declared default ("none" = no names).
   std::vector<std::string> names(const std::string& name) const;
   std::filesystem::path path(const std::string& name) const;

@@ -36,6 +36,8 @@ enum class Type {
   Enum,             // one of `allowed`
   Vector2,          // [x, y]
   NumberOrVector2,  // x (y = 0) or [x, y]
+  Vector,           // [x, y] or [x, y, z]: as many components as the model's dimension
+  NumberOrVector,   // x (the other components 0), [x, y] or [x, y, z]
   Names,            // a name or a list of names
   StringList,       // a list of names
   IntList,          // a list of `size` integers
@@ -163,6 +165,8 @@ Key text(std::string name, std::string meaning);
 Key choice(std::string name, std::vector<std::string> values, std::string meaning);
 Key vector2(std::string name, std::string meaning);
 Key number_or_vector2(std::string name, std::string meaning);
+Key vector(std::string name, std::string meaning);            // 2 or 3 components (Reader::vector)
+Key number_or_vector(std::string name, std::string meaning);  // a number or 2 or 3 components
 Key names(std::string name, std::string meaning);
 Key string_list(std::string name, std::string meaning);
 Key int_list(std::string name, int size, std::string meaning);

@@ -3,7 +3,8 @@
 // fluid, in Eigen types. The service layer (protocol/) translates wire messages into
 // these calls; the solvers know nothing of sockets or protobuf.
 //
-// Interface vectors are interleaved per node: [x0, y0, x1, y1, ...].
+// Interface vectors are interleaved per node: [x0, y0, x1, y1, ...] in 2D,
+// [x0, y0, z0, x1, ...] in 3D (InterfaceMeshData::dimension).
 //
 // Call order (enforced by the service layer):
 //   configure() -> interface() -> { solve_step(k = 1..) ... accept_step() } ... -> write_output()
@@ -42,28 +43,47 @@ class CheckpointUnsupported : public std::runtime_error {
   throw CheckpointUnsupported("model '" + model + "' does not support checkpoints");
 }
 
-// A scalar matrix on interface nodes that acts on x and y alike (an interface mass
-// int N_i N_j dgamma); 0 x 0 = not given.
+// A scalar matrix on interface nodes that acts on every component alike (an interface
+// mass int N_i N_j dgamma); 0 x 0 = not given.
 using NodalMatrix = Eigen::SparseMatrix<double>;
 
-// (M (x) I_2) v for interleaved v = [x0, y0, x1, y1, ...].
+// (M (x) I_d) v for interleaved v = [x0, y0, (z0,) x1, ...]; d = v.size() / m.rows().
 inline Eigen::VectorXd apply_nodal(const NodalMatrix& m, const Eigen::VectorXd& v) {
-  const Eigen::Map<const Eigen::Matrix<double, 2, Eigen::Dynamic>> V(v.data(), 2, v.size() / 2);
   Eigen::VectorXd out(v.size());
-  Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>> O(out.data(), 2, v.size() / 2);
+  if (m.rows() == 0 || v.size() == 2 * m.rows()) {  // the 2D path, fixed-size as always
+    const Eigen::Map<const Eigen::Matrix<double, 2, Eigen::Dynamic>> V(v.data(), 2, v.size() / 2);
+    Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>> O(out.data(), 2, v.size() / 2);
+    O = (m * V.transpose()).transpose();
+    return out;
+  }
+  const Eigen::Index d = v.size() / m.rows();
+  const Eigen::Map<const Eigen::MatrixXd> V(v.data(), d, m.rows());
+  Eigen::Map<Eigen::MatrixXd> O(out.data(), d, m.rows());
   O = (m * V.transpose()).transpose();
   return out;
 }
 
+// One face of a 3D interface: local node indices in gmsh order. 3 = linear triangle,
+// 6 = quadratic triangle, 4 = bilinear quadrilateral, 8 = serendipity, 9 = biquadratic.
+struct InterfaceFace {
+  std::vector<int> nodes;
+};
+
 struct InterfaceMeshData {
+  int dimension = 2;  // 2: segments, 2 values per node; 3: faces, 3 values per node
   std::vector<std::int64_t> node_ids;
-  Eigen::MatrixX2d coordinates;              // reference configuration, n x 2
-  std::vector<std::array<int, 2>> segments;  // local indices; empty for a point interface
-  Eigen::VectorXd lumped_measure;            // used when segments is empty (size n)
-  Eigen::VectorXd initial_displacement;      // 2n, or empty = zero
-  Eigen::VectorXd initial_velocity;          // 2n, or empty = zero
+  Eigen::MatrixXd coordinates;               // reference configuration, n x dimension
+  std::vector<std::array<int, 2>> segments;  // 2D: local indices; empty for a point interface
+  std::vector<InterfaceFace> faces;          // 3D: local indices; empty for a point interface
+  Eigen::VectorXd lumped_measure;            // used when there are no segments/faces (size n)
+  Eigen::VectorXd initial_displacement;      // dimension * n, or empty = zero
+  Eigen::VectorXd initial_velocity;          // dimension * n, or empty = zero
   double mass_per_area = 0;                  // a solid's m_s / |Gamma| (coupling.robin_auto); 0 = unknown
   std::size_t nodes() const { return static_cast<std::size_t>(coordinates.rows()); }
+  // Values of an interface vector: dimension per node.
+  std::size_t values() const { return nodes() * static_cast<std::size_t>(dimension); }
+  // A point interface: no segments or faces, the measure lumped per node.
+  bool points_only() const { return segments.empty() && faces.empty(); }
 };
 
 struct StepInfo {
@@ -82,8 +102,8 @@ struct SolidSetup {
 };
 
 struct SolidStepResult {
-  Eigen::VectorXd interface_displacement;  // 2n
-  Eigen::VectorXd interface_velocity;      // 2n
+  Eigen::VectorXd interface_displacement;  // dimension * n
+  Eigen::VectorXd interface_velocity;      // dimension * n
   int newton_iterations = 0;
 };
 
@@ -116,7 +136,7 @@ class SolidModel : public IterationReporting {
   // Reads this solver's section of the scene; must read every key it accepts.
   virtual void configure(const ConfigSection& section, const SolidSetup& setup) = 0;
   virtual InterfaceMeshData interface() const = 0;
-  // Solves step n+1 for the nodal interface force F^(k)_{n+1} (2n). Repeated calls for the
+  // Solves step n+1 for the nodal interface force F^(k)_{n+1} (dimension * n). Repeated calls for the
   // same step restart from the last accepted state.
   virtual SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) = 0;
   // Makes the last solve the new accepted state; returns named probes.
@@ -155,8 +175,8 @@ struct FluidSetup {
 };
 
 struct FluidLoads {
-  Eigen::VectorXd traction_force;     // f_sigma = int N^T sigma n dgamma (2n)
-  Eigen::VectorXd velocity_integral;  // f_v = int N^T v_f dgamma (2n)
+  Eigen::VectorXd traction_force;     // f_sigma = int N^T sigma n dgamma (dimension * n)
+  Eigen::VectorXd velocity_integral;  // f_v = int N^T v_f dgamma (dimension * n)
   int nonlinear_iterations = 0;
   NodalMatrix interface_mass;  // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
 };

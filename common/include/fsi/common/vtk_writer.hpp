@@ -15,7 +15,18 @@
 
 namespace fsi {
 
-enum class VtkCellType : int { Vertex = 1, Line = 3, Triangle = 5, Quad = 9, Hexahedron = 12 };
+enum class VtkCellType : int {
+  Vertex = 1,
+  Line = 3,
+  Triangle = 5,
+  Quad = 9,
+  Tetra = 10,
+  Hexahedron = 12,
+  QuadraticTriangle = 22,
+  QuadraticQuad = 23,
+  QuadraticTetra = 24,
+  BiquadraticQuad = 28
+};
 
 struct VtkGrid {
   Eigen::MatrixXd points;                             // n x 2 or n x 3

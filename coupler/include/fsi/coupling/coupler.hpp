@@ -107,6 +107,7 @@ class Coupler {
   void automatic_robin(const TimeSettings& time);  // coupling.robin_auto: gamma from the solid's mass
   // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
   void describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface);
+  void check_gap(nlohmann::json& data, const InterfaceMeshData& fluid_interface) const;
   // 2. The state the first step starts from: a checkpoint (resume, fork) or the initial one.
   void start_state(Run& r);
   void find_restart(Run& r);  // --resume's checkpoint, forked_from.json

@@ -4,7 +4,9 @@
 //    takes the linear interpolant of the solid's interface polyline at its closest point;
 //  - forces: the transpose, F_s = H^T f_f (conservative), so that the power across the
 //    interface is the same on both sides: F_s . v_s = f_f . v_f exactly.
-// A point interface (no segments) maps node to nearest node.
+// A point interface (no segments) maps node to nearest node. In 3D the same with faces: each
+// fluid node takes the solid's face interpolant at its closest point on the solid's faces
+// (triangles and quadrilaterals, linear or quadratic), forces again by H^T.
 // Radial basis functions instead (MappingSettings): H interpolates the solid's nodal values
 // at the fluid's nodes by s(x) = sum_j lambda_j phi(|x - x_j|) + a + b . x over the solid's
 // interface nodes (segments unused), forces again by H^T. The linear term makes H exact for
@@ -19,6 +21,7 @@
 #include <Eigen/SparseCore>
 #include <string>
 
+#include "fsi/common/interface_geometry.hpp"
 #include "fsi/common/solver_model.hpp"
 
 namespace fsi::coupling {
@@ -67,9 +70,13 @@ class InterfaceMap {
 
  private:
   // Whether H is a permutation (conforming meshes): coincident_nodes_, conforming_, permutation_error_.
+  template <int D>
   void detect_conforming(const InterfaceMeshData& solid, const InterfaceMeshData& fluid);
   // Replaces hs_ by the RBF interpolation matrix (n_f x n_s, dense).
+  template <int D>
   void build_rbf(const InterfaceMeshData& solid, const InterfaceMeshData& fluid, const MappingSettings& mapping);
+  // 3D: the closest-point projection onto the solid's faces.
+  void build_nearest_3d(const InterfaceMeshData& solid, const InterfaceMeshData& fluid);
   void set_from_scalar(const Eigen::MatrixXd& hs);
   Eigen::SparseMatrix<double> h_, ht_;
   Eigen::SparseMatrix<double> hs_, hst_;  // the scalar (per node) H, n_f x n_s, and its transpose
@@ -83,12 +90,13 @@ class InterfaceMap {
   double support_radius_ = 0;
   int linear_terms_ = 0;
   double condition_ = 0;
+  int dim_ = 2;  // values per node
 };
 
-// M_G = int N^T N dgamma on the solid interface (2n x 2n, consistent, current
+// M_G = int N^T N dgamma on the solid interface (dn x dn, consistent, current
 // configuration = reference + displacement); diag(lumped_measure) for a point interface.
 Eigen::SparseMatrix<double> interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement);
-// The same as a scalar matrix on the solid's interface nodes (n x n).
-NodalMatrix nodal_interface_mass(const InterfaceMeshData& solid, const Eigen::VectorXd& displacement);
+// The same as a scalar matrix on the solid's interface nodes (n x n): fsi::nodal_interface_mass.
+using fsi::nodal_interface_mass;
 
 }  // namespace fsi::coupling

@@ -106,6 +106,10 @@ struct CouplingSettings {
   // coupling.growth: max |d| of the last window steps > factor x that of the window before = diverged
   double growth_factor = 1000;
   int growth_window = 200;
+  // coupling.interface_gap: the fluid's largest gap to the solid's interface, as a fraction of
+  // the solid interface's median element size: warn above gap_warn, refuse above gap_refuse (0 = never)
+  double gap_warn = 0.05;
+  double gap_refuse = 0.5;
   double residual_floor = 1e-14;  // absolute floor of the residual's denominator
   RobinMass robin_mass = RobinMass::Consistent;
   // iterations.measures (or, without it, iterations.tolerance as {force, relative}); empty =

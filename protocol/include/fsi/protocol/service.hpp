@@ -54,6 +54,7 @@ class SolidService : public Service {
   std::string server_name_;
   std::unique_ptr<SolidModel> model_;
   std::size_t interface_nodes_ = 0;
+  int dimension_ = 2;  // of the model's interface
   double dt_ = 0;
 };
 
@@ -70,6 +71,7 @@ class FluidService : public Service {
   std::string server_name_;
   std::unique_ptr<FluidModel> model_;
   std::size_t interface_nodes_ = 0;
+  int dimension_ = 2;  // of the model's interface
 };
 
 // Binds `endpoint`, writes the bound endpoint to `port_file` (if non-empty, atomically),

@@ -29,12 +29,34 @@
 #include "fsi/common/solver_model.hpp"
 #include "fsi/common/state.hpp"
 #include "fsi/fluid/mesh.hpp"
+#include "fsi/fluid/tet_mesh.hpp"
 
 namespace fsi::fluid {
 
 struct TransferReport;  // field_transfer.hpp
 
-using VelocityFunction = std::function<Eigen::Vector2d(const Eigen::Vector2d& x, double t)>;
+// The dimension is a template parameter of the solver (FlowSolver: 2D triangles, FlowSolver3:
+// 3D tetrahedra); a point, the nodal values of a vector field and the mesh follow from it.
+template <int Dim>
+using Point = Eigen::Matrix<double, Dim, 1>;
+template <int Dim>
+using NodeMatrix = Eigen::Matrix<double, Eigen::Dynamic, Dim>;  // one row per node
+template <int Dim>
+struct MeshType;
+template <>
+struct MeshType<2> {
+  using type = FluidMesh;
+};
+template <>
+struct MeshType<3> {
+  using type = TetMesh;
+};
+template <int Dim>
+using MeshOf = typename MeshType<Dim>::type;
+
+template <int Dim>
+using VelocityFunctionT = std::function<Point<Dim>(const Point<Dim>& x, double t)>;
+using VelocityFunction = VelocityFunctionT<2>;
 
 enum class TimeScheme { Steady, BDF1, BDF2 };
 
@@ -112,22 +134,28 @@ struct StepReport {
   int krylov_iterations = 0;
 };
 
-class FlowSolver {
+template <int Dim>
+class BasicFlowSolver {
  public:
-  // `element`: "p1p1" (3-node triangles) or "p2p1" (6-node triangles; a linear mesh gets
-  // straight midpoints). std::invalid_argument when the mesh does not suit the element.
-  FlowSolver(FluidMesh mesh, FlowParameters params, const std::string& element);
-  ~FlowSolver();
-  FlowSolver(FlowSolver&&) noexcept;
-  FlowSolver& operator=(FlowSolver&&) noexcept;
+  using Mesh = MeshOf<Dim>;
+  using PointD = Point<Dim>;
+  using Nodes = NodeMatrix<Dim>;
+  using Velocity = VelocityFunctionT<Dim>;
+  // `element`: 2D "p1p1" (3-node triangles) or "p2p1" (6-node triangles; a linear mesh gets
+  // straight midpoints); 3D "p2p1" (10-node tetrahedra; a linear mesh gets straight midpoints).
+  // std::invalid_argument when the mesh does not suit the element.
+  BasicFlowSolver(Mesh mesh, FlowParameters params, const std::string& element);
+  ~BasicFlowSolver();
+  BasicFlowSolver(BasicFlowSolver&&) noexcept;
+  BasicFlowSolver& operator=(BasicFlowSolver&&) noexcept;
 
   // --- set-up (before the first solve) ---
-  void add_dirichlet(const std::string& group, VelocityFunction velocity);  // strong, both components
-  void add_symmetry(const std::string& group);                              // u.n = 0 (axis-aligned)
-  void set_interface(const std::vector<std::string>& groups);               // Nitsche groups
-  void set_pressure_reference(const Eigen::Vector2d& point, std::function<double(double)> value);  // nearest vertex
-  void set_body_force(VelocityFunction force);
-  void set_initial_velocity(const Eigen::MatrixX2d& velocity);  // per node
+  void add_dirichlet(const std::string& group, Velocity velocity);                        // strong, both components
+  void add_symmetry(const std::string& group);                                            // u.n = 0 (axis-aligned)
+  void set_interface(const std::vector<std::string>& groups);                             // Nitsche groups
+  void set_pressure_reference(const PointD& point, std::function<double(double)> value);  // nearest vertex
+  void set_body_force(Velocity force);
+  void set_initial_velocity(const Nodes& velocity);  // per node
   // Called after each nonlinear iteration of solve() with the iteration and the relative change.
   void set_iteration_observer(std::function<void(int, double)> observer) { observer_ = std::move(observer); }
 
@@ -135,8 +163,7 @@ class FlowSolver {
   // Solves time level `time` (= t_n + dt) from the accepted state, on the mesh at `positions`
   // (every node, current configuration), with the interface velocity per interface node
   // (interleaved, 2 * interface_nodes().size(); empty = zero). Repeatable before accept().
-  StepReport solve(double time, double dt, const Eigen::MatrixX2d& positions,
-                   const Eigen::VectorXd& interface_velocity);
+  StepReport solve(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
   void accept();
 
   // --- checkpoints (after accept()) ---
@@ -157,13 +184,13 @@ class FlowSolver {
   // nodes `old_node` names (the kept boundary nodes: -1 = a new node); the step counts and
   // sizes and the interface velocity. The new mesh's reference positions are its current ones.
   // The reactions restart at zero (the next solve makes them). Returns the interpolation report.
-  TransferReport transfer_state(const FlowSolver& old, const std::vector<int>& old_node);
+  TransferReport transfer_state(const BasicFlowSolver& old, const std::vector<int>& old_node);
   // A fresh start from the present velocity and pressure (after transfer_state from another
   // run's state): no history (the next step is BDF1), the mesh at rest, no interface velocity.
   void restart_history();
 
   // --- results of the last solve ---
-  const FluidMesh& mesh() const;
+  const Mesh& mesh() const;
   const FlowParameters& parameters() const { return params_; }
   int dofs() const;
   // Every unknown: P1/P1 (u, v, p) per node; P2/P1 (u, v) per node at 2 i, 2 i + 1, then p per vertex.
@@ -172,13 +199,13 @@ class FlowSolver {
   // The system of the last solve (constraints applied) and its right-hand side (benchmarks).
   const Eigen::SparseMatrix<double>& last_matrix() const;
   const Eigen::VectorXd& last_rhs() const;
-  Eigen::MatrixX2d velocity() const;  // per node
-  Eigen::VectorXd pressure() const;   // per node (P2/P1: linear between the vertices)
-  const Eigen::MatrixX2d& positions() const { return X_; }
-  const Eigen::MatrixX2d& accepted_positions() const { return X_n_; }
+  Nodes velocity() const;            // per node
+  Eigen::VectorXd pressure() const;  // per node (P2/P1: linear between the vertices)
+  const Nodes& positions() const { return X_; }
+  const Nodes& accepted_positions() const { return X_n_; }
   // Force of the fluid on the body bounded by the groups: minus the sum of the momentum
   // reactions (residual of the volume terms) over the groups' nodes (consistent reaction forces).
-  Eigen::Vector2d force(const std::vector<std::string>& groups) const;
+  PointD force(const std::vector<std::string>& groups) const;
   // Interface nodes (P2/P1: vertices and edge midpoints) and their segments (local indices;
   // P2/P1: every edge split at its midpoint).
   const std::vector<int>& interface_nodes() const { return interface_nodes_; }
@@ -191,8 +218,8 @@ class FlowSolver {
   // the quadrature of the Nitsche terms (a scalar matrix on the interface nodes): f_v = M_f v_f
   // and the penalty part of f_sigma is gamma_N1 M_f (v_f - v_s).
   Eigen::SparseMatrix<double> interface_mass() const;
-  double pressure_at(const Eigen::Vector2d& point) const;  // NaN outside the mesh
-  Eigen::Vector2d velocity_at(const Eigen::Vector2d& point) const;
+  double pressure_at(const PointD& point) const;  // NaN outside the mesh
+  PointD velocity_at(const PointD& point) const;
 
  private:
   struct Impl;
@@ -200,7 +227,7 @@ class FlowSolver {
   FlowParameters params_;
   std::unique_ptr<Impl> impl_;
   Eigen::VectorXd U_, U_n_, U_nm1_, reaction_;
-  Eigen::MatrixX2d X_, X_n_, X_nm1_;
+  Nodes X_, X_n_, X_nm1_;
   double dt_n_ = 0;      // last accepted step size
   double dt_trial_ = 0;  // step size of the last solve
   int accepted_ = 0;
@@ -209,9 +236,14 @@ class FlowSolver {
   IndexMatrix2 interface_segments_;
   Eigen::VectorXd interface_velocity_;  // of the last solve
   std::function<void(int, double)> observer_;
-  Step begin_step(double time, double dt, const Eigen::MatrixX2d& positions, const Eigen::VectorXd& interface_velocity);
+  Step begin_step(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
   void assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report);
-  bool locate(const Eigen::Vector2d& point, int& element, Eigen::Vector3d& bary) const;
+  bool locate(const PointD& point, int& element, Eigen::Matrix<double, Dim + 1, 1>& bary) const;
 };
+
+using FlowSolver = BasicFlowSolver<2>;
+using FlowSolver3 = BasicFlowSolver<3>;  // no Nitsche interface, symmetry planes or remeshing yet
+extern template class BasicFlowSolver<2>;
+extern template class BasicFlowSolver<3>;
 
 }  // namespace fsi::fluid

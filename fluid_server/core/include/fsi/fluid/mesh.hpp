@@ -33,6 +33,7 @@ struct FluidMesh {
 
   int node_count() const { return static_cast<int>(nodes.rows()); }
   int triangle_count() const { return static_cast<int>(triangles.rows()); }
+  int cell_count() const { return triangle_count(); }
   const IndexMatrix2& boundary(const std::string& name) const;  // throws listing known names
   bool has_boundary(const std::string& name) const { return boundaries.count(name) > 0; }
   // Sorted unique node indices of the named groups (quadratic meshes: with the midpoints).

@@ -28,10 +28,10 @@ namespace fsi::fluid {
 
 // Runs `gmsh -2` on `geo` with `-setnumber name value` for every parameter, caching the
 // .msh in `cache_dir` under a name derived from the geo text and the parameters.
-// `order` 2 meshes with 6-node triangles and 3-node lines (gmsh -order 2: the midpoints lie on
-// the geometry, so curved boundaries are curved).
+// `dimension` 3 meshes the volume (gmsh -3). `order` 2 meshes with 6-node triangles and 3-node lines (gmsh -order 2:
+// the midpoints lie on the geometry, so curved boundaries are curved).
 std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
-                               const std::filesystem::path& cache_dir, int order = 1);
+                               const std::filesystem::path& cache_dir, int order = 1, int dimension = 2);
 
 // The keys of `fluid.model: fem` (navier_stokes_keys.cpp).
 const std::vector<schema::Key>& navier_stokes_keys();
@@ -79,6 +79,10 @@ class NavierStokesFluid : public FluidModel {
   }
   // Unknowns, mesh nodes and triangles (summary.json of standalone runs).
   std::map<std::string, double> sizes() const override {
+    if (solver3_)
+      return {{"dofs", solver3_->dofs()},
+              {"nodes", solver3_->mesh().node_count()},
+              {"tetrahedra", solver3_->mesh().cell_count()}};
     if (!solver_) return {};
     return {{"dofs", solver_->dofs()},
             {"nodes", solver_->mesh().node_count()},
@@ -93,6 +97,11 @@ class NavierStokesFluid : public FluidModel {
   };
   FluidSetup setup_;
   std::string element_;  // fluid.element: p1p1 or p2p1
+  // fluid.dimension 3: the same FlowSolver on tetrahedra (fluid alone: no interface, no mesh motion).
+  std::unique_ptr<FlowSolver3> solver3_;
+  std::vector<std::pair<std::string, Eigen::Vector3d>> pressure_probes3_;
+  void configure3(const schema::Reader& section);
+  std::map<std::string, double> probes3();
   std::unique_ptr<FlowSolver> solver_;
   FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
   bool motion_on_vertices_ = false;

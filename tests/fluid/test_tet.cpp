@@ -1,0 +1,149 @@
+// The 3D fluid: the tetrahedral quadrature and P2 shape functions, the tetrahedral mesh from
+// gmsh (and a 3D mesh refused by the 2D fluid), and the 3D FlowSolver (Taylor-Hood on
+// tetrahedra) reproducing plane Poiseuille flow exactly (a quadratic velocity, a linear
+// pressure: in the P2/P1 space) with Newton, and refusing an interface.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <sstream>
+
+#include "fsi/common/gmsh_reader.hpp"
+#include "fsi/fluid/flow_solver.hpp"
+#include "fsi/fluid/p2p1_tet_element.hpp"
+
+namespace {
+
+using namespace fsi::fluid;
+
+double factorial(int n) { return n <= 1 ? 1.0 : n * factorial(n - 1); }
+
+TEST(TetQuadrature, ExactForEveryMonomialUpToDegreeFive) {
+  for (int a = 0; a <= 5; ++a)
+    for (int b = 0; a + b <= 5; ++b)
+      for (int c = 0; a + b + c <= 5; ++c) {
+        double sum = 0;
+        for (const auto& q : tet_quadrature()) sum += q.weight * std::pow(q.x, a) * std::pow(q.y, b) * std::pow(q.z, c);
+        const double exact = factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
+        EXPECT_NEAR(sum, exact, 1e-15) << a << " " << b << " " << c;
+      }
+}
+
+TEST(P2TetElement, ShapeFunctionsAreNodalAndReproduceQuadratics) {
+  const double pts[10][3] = {{0, 0, 0},     {1, 0, 0},   {0, 1, 0},   {0, 0, 1},     {0.5, 0, 0},
+                             {0.5, 0.5, 0}, {0, 0.5, 0}, {0, 0, 0.5}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
+  Eigen::Matrix<double, 10, 1> N;
+  Eigen::Matrix<double, 10, 3> dN;
+  for (int k = 0; k < 10; ++k) {
+    p2_tet_shape(pts[k][0], pts[k][1], pts[k][2], N, dN);
+    for (int j = 0; j < 10; ++j) EXPECT_NEAR(N(j), j == k ? 1.0 : 0.0, 1e-15) << k << " " << j;
+  }
+  // f = 1 + x - 2 y z + 3 x^2 interpolated at the nodes is f everywhere, with its gradient.
+  auto f = [](double x, double y, double z) { return 1 + x - 2 * y * z + 3 * x * x; };
+  Eigen::Matrix<double, 10, 1> values;
+  for (int k = 0; k < 10; ++k) values(k) = f(pts[k][0], pts[k][1], pts[k][2]);
+  const double x = 0.21, y = 0.17, z = 0.33;
+  p2_tet_shape(x, y, z, N, dN);
+  EXPECT_NEAR(N.dot(values), f(x, y, z), 1e-14);
+  EXPECT_NEAR(dN.col(0).dot(values), 1 + 6 * x, 1e-13);
+  EXPECT_NEAR(dN.col(1).dot(values), -2 * z, 1e-13);
+  EXPECT_NEAR(dN.col(2).dot(values), -2 * y, 1e-13);
+}
+
+// One tetrahedron given clockwise (negative volume) with one boundary face, MSH 2.2.
+const char* kOneTet = R"($MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+2 2 "wall"
+3 1 "fluid"
+$EndPhysicalNames
+$Nodes
+4
+1 0 0 0
+2 0 1 0
+3 1 0 0
+4 0 0 1
+$EndNodes
+$Elements
+2
+1 2 2 2 2 1 2 3
+2 4 2 1 1 1 2 3 4
+$EndElements
+)";
+
+TEST(TetMesh, FromGmshOrientsTetrahedraAndTheTwoDimensionsRefuseEachOther) {
+  std::istringstream in(kOneTet);
+  const auto g = fsi::read_gmsh(in, "one_tet.msh");
+  ASSERT_TRUE(g.has_volume());
+  const auto m = TetMesh::from_gmsh(g);
+  ASSERT_EQ(m.cell_count(), 1);
+  Eigen::Matrix3d J;
+  for (int k = 0; k < 3; ++k) J.col(k) = (m.nodes.row(m.tets(0, k + 1)) - m.nodes.row(m.tets(0, 0))).transpose();
+  EXPECT_NEAR(J.determinant(), 1.0, 1e-15);  // flipped to positive volume
+  EXPECT_EQ(m.boundary_nodes({"wall"}).size(), 3u);
+  try {
+    (void)FluidMesh::from_gmsh(g);
+    FAIL() << "a 2D fluid took a 3D mesh";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("3D mesh"), std::string::npos) << e.what();
+  }
+  // A 2D mesh (triangles only) for the 3D fluid.
+  std::istringstream in2(
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+      "$Elements\n1\n1 2 2 1 1 1 2 3\n$EndElements\n");
+  EXPECT_THROW((void)TetMesh::from_gmsh(fsi::read_gmsh(in2, "tri.msh")), std::runtime_error);
+}
+
+// Plane Poiseuille flow between y = 0 and y = H in a box with symmetry planes z = const:
+// u = 4 U y (H - y) / H^2, p = 8 mu U (L - x) / H^2 (do-nothing outlet at x = L: p = 0).
+TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
+  const double L = 2, H = 1, U = 1.5, mu = 0.1;
+  TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1);
+  FlowParameters params;
+  params.viscosity = mu;
+  params.scheme = TimeScheme::Steady;
+  params.newton = true;
+  params.max_iterations = 8;
+  params.tolerance = 1e-12;
+  params.stabilisation.supg = false;
+  params.reuse_factorisation = false;
+  FlowSolver3 solver(mesh, params, "p2p1");
+  EXPECT_EQ(solver.dofs(), 3 * solver.mesh().node_count() + solver.mesh().vertices());
+  auto exact = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
+    return {4 * U * x.y() * (H - x.y()) / (H * H), 0, 0};
+  };
+  solver.add_dirichlet("left", exact);
+  solver.add_dirichlet("bottom", exact);
+  solver.add_dirichlet("top", exact);
+  solver.add_symmetry("back");
+  solver.add_symmetry("front");
+  EXPECT_THROW(solver.set_interface({"top"}), std::invalid_argument);
+  const auto report = solver.solve(1, 1, solver.mesh().nodes, {});
+  EXPECT_LT(report.change, 1e-12);
+  const auto v = solver.velocity();
+  double err = 0;
+  for (int i = 0; i < solver.mesh().node_count(); ++i)
+    err = std::max(err, (v.row(i).transpose() - exact(solver.mesh().nodes.row(i).transpose(), 0)).norm());
+  EXPECT_LT(err, 1e-10);
+  for (const Eigen::Vector3d x : {Eigen::Vector3d(0.3, 0.4, 0.2), Eigen::Vector3d(1.7, 0.9, 0.45)}) {
+    EXPECT_NEAR(solver.pressure_at(x), 8 * mu * U * (L - x.x()) / (H * H), 1e-9);
+    EXPECT_NEAR(solver.velocity_at(x).x(), 4 * U * x.y() * (H - x.y()) / (H * H), 1e-10);
+  }
+  // Forces by the residual (reaction) form. A single wall cannot be compared with its shear
+  // alone: the nodes it shares with the inlet also carry their part of the inlet pressure (the
+  // reaction at a node is the traction integrated against its shape function over every face it
+  // touches). The union of the inlet and both walls is a closed balance: the inlet pushes with
+  // p(0) H W = 8 mu U L / H^2 * H * W in +x, the walls hold with 2 * (4 mu U / H) L W in -x, and
+  // these cancel (the outlet carries no x traction, the symmetry planes none either). The
+  // balance holds to round-off only if every reaction is assembled consistently.
+  const double W = 0.5;
+  const Eigen::Vector3d f = solver.force({"left", "bottom", "top"});
+  EXPECT_NEAR(f.x(), 0, 1e-9);
+  EXPECT_NEAR(f.z(), 0, 1e-9);
+  // The walls and the inlet separately are far from zero: the sum is not trivially small.
+  EXPECT_GT(std::abs(solver.force({"bottom"}).x()), 0.5 * 4 * mu * U / H * L * W);
+}
+
+}  // namespace
