@@ -402,15 +402,15 @@ def misbehaving_solid(env):
     """An external solid that never answers Hello, never writes its port file, answers as
     a fluid or with another protocol version: the launcher stops, names the cause, leaves
     a final summary.json and no process behind, within its documented waits (port file
-    10 s, Hello 5 s, 1 s to exit after a failed run)."""
+    60 s, Hello 30 s, 1 s to exit after a failed run)."""
     fake = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fake_solid.py")
-    expected = {"silent": "no reply from solid server", "noport": "did not report its endpoint within 10 s",
+    expected = {"silent": "no reply from solid server", "noport": "did not report its endpoint within 60 s",
                 "wrongkind": "is a SERVER_KIND_FLUID server, expected a SERVER_KIND_SOLID server",
                 "oldversion": "speaks protocol version 7 (HelloReply.protocol_version), this coupler 1"}
     for mode, text in expected.items():
         out = env.out(mode)
         start = time.time()
-        code, log = env.fsi("sdof_model.yaml", out, timeout=60,
+        code, log = env.fsi("sdof_model.yaml", out, timeout=120,
                             extra=["--solid-command", f"{sys.executable} {fake} --mode {mode} --proto-dir {env.proto}"])
         elapsed = time.time() - start
         assert code == 1, (mode, code, log)
