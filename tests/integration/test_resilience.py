@@ -152,6 +152,11 @@ RESUME_CASES = {
     # secant pairs of the stacked [d; v; F] across the checkpoint.
     "added_mass_parallel": ("added_mass.yaml", ["time.end=20", "time.checkpoint_every=100", "coupling.scheme=parallel",
                                                 "coupling.acceleration=iqn-ils", "coupling.relaxation=0.5"], 1250, 60),
+    # Three dimensions: the plate interfaces (solid quadrilaterals, fluid triangles), 3 values
+    # per node in every checkpointed vector, with added mass and IQN-ILS's secant pairs.
+    "sdof_3d": ("sdof_3d.yaml", ["time.end=40", "time.checkpoint_every=100", "time.output_every=0",
+                                 "fluid.added_mass=0.8", "coupling.acceleration=iqn-ils", "coupling.relaxation=0.5",
+                                 "coupling.iterations={max: 20, tolerance: 1.0e-8}"], 1450, 90),
     "thick_beam_imvj": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10", "coupling.algorithm=2",
                                             "coupling.acceleration=iqn-imvj", "coupling.predictor=quadratic",
                                             "coupling.iqn={imvj: {restart: rs-ls, chunk_size: 4, restart_reuse_steps: 2}, "
@@ -205,6 +210,9 @@ def resume_small(env):
     solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
     RESUME_CASES["python_solid"] = RESUME_CASES["sdof_model"]
     resume_case(env, "python_solid", "SIGINT", ("--solid-command", solid))
+    resume_case(env, "sdof_3d", "kill -9 coupler")
+    RESUME_CASES["python_solid_3d"] = RESUME_CASES["sdof_3d"]
+    resume_case(env, "python_solid_3d", "SIGINT", ("--solid-command", solid))
 
 
 def resume_thick_beam(env):
