@@ -50,9 +50,9 @@ namespace fs = std::filesystem;
 namespace {
 
 // Launcher limits: a server must write its port file within 60 s of starting and answer the
-// coupler's Hello within 30 s (generous: a loaded machine, a Python solver importing its modules); at the end each process gets 3 s to exit after Stop (1 s when
-// the run failed: a server that never answered got no Stop it could obey), then SIGTERM,
-// then SIGKILL 0.5 s later.
+// coupler's Hello within 30 s (generous: a loaded machine, a Python solver importing its modules); at the end each
+// process gets 3 s to exit after Stop (1 s when the run failed: a server that never answered got no Stop it could
+// obey), then SIGTERM, then SIGKILL 0.5 s later.
 constexpr std::chrono::seconds kPortFileWait{60};
 constexpr int kHelloWaitSeconds = 30;  // generous: a loaded machine, a Python solver importing its modules
 

@@ -401,7 +401,9 @@ void Coupler::check_gap(nlohmann::json& data, const InterfaceMeshData& fluid_int
   const Eigen::MatrixXd& x = solid.coordinates;
   for (const auto& s : solid.segments) sizes.push_back((x.row(s[1]) - x.row(s[0])).norm());
   for (const auto& f : solid.faces) sizes.push_back(std::sqrt(face_area(x, f)));
-  if (sizes.empty()) return;  // a point interface: no element size to measure the gap against
+  // A point interface: no element size to measure the gap against; a one-node fluid (a model
+  // such as the surrogate, which pushes wherever the solid is) has no place to be off.
+  if (sizes.empty() || fluid_interface.nodes() == 1) return;
   std::nth_element(sizes.begin(), sizes.begin() + static_cast<std::ptrdiff_t>(sizes.size() / 2), sizes.end());
   const double h = sizes[sizes.size() / 2];
   const double ratio = h > 0 ? map_.max_gap() / h : 0;

@@ -30,12 +30,14 @@ declaration_files = {
     "fluid_server/src/surrogate_keys.cpp": "fluid",
     "fluid_server/src/fluid_keys.cpp": "fluid",
     "fluid_server/core/src/navier_stokes_keys.cpp": "fluid",
+    # the point models' interface (dimension, surface), in both the solid and the fluid section
+    "common/src/model_interface_keys.cpp": "interface",
 }
 # The schema's own code (the builders, the checker, Scene's scene/description) may use both.
 schema_files = {"common/src/scene_declare.cpp", "common/src/scene_schema.cpp", "common/src/config.cpp",
                 "common/include/fsi/common/config.hpp", "common/include/fsi/common/scene_schema.hpp",
                 "common/include/fsi/common/scene_reader.hpp", "common/src/scene_reader.cpp"}
-component_of = {"time": "common/", "coupling": "coupler/", "solid": "solid_server/", "fluid": "fluid_server/"}
+component_of = {"time": "common/", "interface": "common/", "coupling": "coupler/", "solid": "solid_server/", "fluid": "fluid_server/"}
 
 problems = []
 declared_in = []

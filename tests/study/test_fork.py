@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """A study with `from:` forks every run from a developed state (fsi run --from): each run starts
-after the checkpoint's time, the runs with the scene's own settings continue the developed run
+after the developed run's last checkpoint (its final step), the runs with the scene's own settings continue the developed run
 exactly (byte-identical rows against running it on), and `from` is part of the runs' names."""
 import csv
 import json
@@ -10,9 +10,9 @@ from common import FSI, SRC, check, results, run_tool, work_dir
 
 w = work_dir("/tmp/study_test_fork")
 dev = w / "developed"
-p = subprocess.run([FSI, "run", str(SRC / "configs/sdof_model.yaml"), "--out", str(dev), "--set", "time.end=1.02",  # the last step is not checkpointed: step 50 is
+p = subprocess.run([FSI, "run", str(SRC / "configs/sdof_model.yaml"), "--out", str(dev), "--set", "time.end=1.02",  # checkpoints at step 50 and the final step 51
                     "--set", "time.checkpoint_every=25"], capture_output=True, text=True, timeout=60)
-check(p.returncode == 0, f"developed run to t = 1.02, a checkpoint at t = 1: exit {p.returncode} {p.stderr[-300:]}")
+check(p.returncode == 0, f"developed run to t = 1.02, checkpointed at its end: exit {p.returncode} {p.stderr[-300:]}")
 on = w / "continued"
 p = subprocess.run([FSI, "run", str(SRC / "configs/sdof_model.yaml"), "--out", str(on), "--set", "time.end=2.0"],
                    capture_output=True, text=True, timeout=60)
@@ -43,15 +43,15 @@ scene_beta = [ln.split(":", 1)[1].split("#")[0].strip() for ln in (SRC / "config
 for r in rows:
     t = table(w / "out" / "runs" / r["name"] / "probes.csv")
     first = float(t[1][0])
-    check(abs(first - 1.02) < 1e-9, f"{r['name']}: the first row is the step after the checkpoint (t = {first})")
-    check(len(t) - 1 == 50, f"{r['name']}: 50 steps from t = 1 to 2 ({len(t) - 1})")
+    check(abs(first - 1.04) < 1e-9, f"{r['name']}: the first row is the step after the final checkpoint (t = {first})")
+    check(len(t) - 1 == 49, f"{r['name']}: 49 steps from t = 1.02 to 2 ({len(t) - 1})")
     if float(r["coupling.relaxation"]) == float(scene_beta):
-        check(t[1:] == full[51:], f"{r['name']}: the scene's own settings continue the developed run exactly")
-for r in rows:  # the run's own steps and iterations (the developed run's 50 steps are not counted)
+        check(t[1:] == full[52:], f"{r['name']}: the scene's own settings continue the developed run exactly")
+for r in rows:  # the run's own steps and iterations (the developed run's 51 steps are not counted)
     s = json.loads((w / "out" / "runs" / r["name"] / "summary.json").read_text())
-    want = (s["coupling_iterations"] - s["forked_from"]["iterations"]) / 50
-    check(int(r["steps"]) == 50 and abs(float(r["iterations_per_step"]) - want) < 1e-12,
-          f"{r['name']}: results.csv counts the fork's own 50 steps, {want:.3f} iterations per step")
+    want = (s["coupling_iterations"] - s["forked_from"]["iterations"]) / 49
+    check(int(r["steps"]) == 49 and abs(float(r["iterations_per_step"]) - want) < 1e-12,
+          f"{r['name']}: results.csv counts the fork's own 49 steps, {want:.3f} iterations per step")
 p = run_tool("run", str(study), "--out", str(w / "out"), "--fsi", FSI, "--jobs", "1")
 check("0 run(s) started, 2 done before" in p.stderr, "a second invocation runs nothing")
 names_without = {n.split("-")[-1] for n in (r["name"] for r in rows)}

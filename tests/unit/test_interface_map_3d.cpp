@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <random>
 
@@ -223,6 +224,57 @@ TEST_P(Rbf3d, RotationsAndAffineFieldsAreExactOnACurvedSurface) {
 INSTANTIATE_TEST_SUITE_P(Kernels, Rbf3d,
                          ::testing::Values(fsi::coupling::MappingKind::RbfThinPlateSpline,
                                            fsi::coupling::MappingKind::RbfWendlandC2));
+
+// Half a cylinder of radius R (theta in [0, pi], z in [0, H]): its nodes on the cylinder, its
+// faces the chords between them (linear) or, quadratic, curved through mid-edge nodes that are
+// on the cylinder too.
+InterfaceMeshData half_cylinder(int n_theta, int n_z, bool triangles, bool curved) {
+  const double R = 0.5, H = 1.0;
+  auto m = fsi::rectangle_surface(Eigen::Vector3d(0.5, 0.5, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1.0,
+                                  1.0, n_theta, n_z, triangles);
+  if (curved) m = quadratic(m);
+  for (Eigen::Index i = 0; i < m.coordinates.rows(); ++i) {
+    const double theta = M_PI * m.coordinates(i, 0), z = H * m.coordinates(i, 1);
+    m.coordinates.row(i) << R * std::cos(theta), R * std::sin(theta), z;
+  }
+  m.lumped_measure = fsi::lumped_interface_measure(m);
+  return m;
+}
+
+// A smooth field on the cylinder, mapped from a coarse solid mesh to a fine fluid one whose
+// nodes lie on the true cylinder (off the solid's faceted faces): the nearest projection
+// converges at second order with flat (linear) faces and at third order or better with
+// curved quadratic ones; RBF keeps affine fields exact on the curved surface.
+TEST(Cylinder3d, ProjectionConvergesOnACurvedSurface) {
+  auto field = [](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(std::sin(2 * x.z()) * x.x(), std::cos(x.y() + x.z()), x.x() * x.y());
+  };
+  auto error = [&](const InterfaceMeshData& solid, const InterfaceMeshData& fluid) {
+    Eigen::VectorXd us(3 * solid.coordinates.rows());
+    for (Eigen::Index i = 0; i < solid.coordinates.rows(); ++i)
+      us.segment<3>(3 * i) = field(solid.coordinates.row(i).transpose());
+    const Eigen::VectorXd uf = fsi::coupling::InterfaceMap(solid, fluid).to_fluid(us);
+    double e = 0;
+    for (Eigen::Index i = 0; i < fluid.coordinates.rows(); ++i)
+      e = std::max(e, (uf.segment<3>(3 * i) - field(fluid.coordinates.row(i).transpose())).norm());
+    return e;
+  };
+  const auto fluid = half_cylinder(48, 20, true, false);
+  for (bool curved : {false, true}) {
+    std::vector<double> e;
+    for (int n : {4, 8, 16}) e.push_back(error(half_cylinder(n, n / 2, false, curved), fluid));
+    const double order = std::log2(e[1] / e[2]);
+    std::cout << (curved ? "quad9" : "quad4") << " faces: errors " << e[0] << ", " << e[1] << ", " << e[2] << ", order "
+              << std::log2(e[0] / e[1]) << ", " << order << "\n";
+    EXPECT_GT(order, curved ? 2.7 : 1.8) << (curved ? "quad9" : "quad4");
+  }
+  // RBF: affine fields exact at the fluid's nodes on the true cylinder.
+  fsi::coupling::MappingSettings rbf;
+  rbf.kind = fsi::coupling::MappingKind::RbfThinPlateSpline;
+  const auto solid = half_cylinder(6, 4, false, false);
+  const fsi::coupling::InterfaceMap map(solid, fluid, rbf);
+  EXPECT_LT((map.to_fluid(affine(solid, kA, kB)) - affine(fluid, kA, kB)).lpNorm<Eigen::Infinity>(), 1e-9);
+}
 
 TEST(InterfaceMap3d, MeshesOfDifferentDimensionsAreRefusedNamingBoth) {
   const auto solid = plate(2, 2, false);

@@ -410,4 +410,14 @@ Eigen::Vector4d quad_face_weights(const Eigen::Matrix<double, 4, 3>& X) {
   return out;
 }
 
+Eigen::Matrix<double, 4, 3> quad_face_area_vectors(const Eigen::Matrix<double, 4, 3>& X) {
+  Eigen::Matrix<double, 4, 3> out = Eigen::Matrix<double, 4, 3>::Zero();
+  for (const auto& [xi, w] : Quad4::gauss()) {
+    const Eigen::Matrix<double, 4, 2> dN = Quad4::derivatives(xi);
+    const Eigen::Matrix<double, 3, 2> T = X.transpose() * dN;  // tangents
+    out += w * Quad4::shape(xi) * T.col(0).cross(T.col(1)).transpose();
+  }
+  return out;
+}
+
 }  // namespace fsi::solid

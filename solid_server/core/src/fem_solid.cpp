@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include "fsi/common/interface_geometry.hpp"
@@ -36,6 +38,15 @@ SolidMesh build_mesh(const schema::Reader& m) {
       m.fail("divisions", "must be [nx, ny, nz] with nx, ny, nz >= 1");
     if (!(size.minCoeff() > 0)) m.fail("size", "must be positive");
     return box_mesh(origin, size, n[0], n[1], n[2]);
+  }
+  if (type == "tube") {
+    const Eigen::Vector3d origin = vec(m, "origin", 3);
+    const auto n = m.get<std::vector<int>>("divisions");
+    if (n[0] < 3 || n[1] < 1 || n[2] < 1)
+      m.fail("divisions", "must be [n_theta, n_r, n_z] with n_theta >= 3, n_r, n_z >= 1");
+    const double ri = m.get<double>("inner_radius"), ro = m.get<double>("outer_radius");
+    if (!(ro > ri)) m.fail("outer_radius", fmt::format("must be larger than inner_radius ({})", ri));
+    return tube_mesh(origin, ri, ro, m.get<double>("length"), n[0], n[1], n[2]);
   }
   if (type == "rectangle") {
     const Eigen::Vector2d origin = vec(m, "origin", 2);
@@ -190,6 +201,53 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
         for (int a = 0; a < 4; ++a) X.row(a) = mesh_.nodes.row(e[static_cast<std::size_t>(a)]);
         const Eigen::Vector4d w = quad_face_weights(X);
         for (int a = 0; a < 4; ++a) dead_load_.segment<3>(3 * e[static_cast<std::size_t>(a)]) += w(a) * traction;
+      }
+    }
+  }
+
+  // Dead pressures: -p int N n0 dA with n0 the outward normal of the reference configuration,
+  // oriented away from the cell that holds the facet (whatever the facet's node order).
+  if (!s.list("pressures").empty()) {
+    std::map<std::vector<int>, int> cell_of;  // sorted facet nodes -> a cell holding them
+    std::map<int, std::vector<int>> cells_of_node;
+    for (int c = 0; c < mesh_.num_cells(); ++c)
+      for (int v : mesh_.cells[static_cast<std::size_t>(c)]) cells_of_node[v].push_back(c);
+    auto holder = [&](const Facet& f) {
+      for (int c : cells_of_node[f[0]]) {
+        const auto& cell = mesh_.cells[static_cast<std::size_t>(c)];
+        if (std::all_of(f.begin(), f.end(),
+                        [&](int v) { return std::find(cell.begin(), cell.end(), v) != cell.end(); }))
+          return c;
+      }
+      return -1;
+    };
+    for (const auto& p : s.list("pressures")) {
+      const double pressure = p.get<double>("pressure");
+      std::vector<Facet> facets;
+      try {
+        facets = mesh_.facets(p.names("boundary"));
+      } catch (const std::invalid_argument& e) {
+        p.fail("boundary", e.what());
+      }
+      for (const auto& f : facets) {
+        const int c = holder(f);
+        if (c < 0) p.fail("boundary", "a facet that is no cell's side");
+        Eigen::VectorXd centre = Eigen::VectorXd::Zero(dim), facet_centre = Eigen::VectorXd::Zero(dim);
+        for (int v : mesh_.cells[static_cast<std::size_t>(c)]) centre += mesh_.nodes.row(v).transpose();
+        centre /= static_cast<double>(mesh_.cells[static_cast<std::size_t>(c)].size());
+        for (int v : f) facet_centre += mesh_.nodes.row(v).transpose() / static_cast<double>(f.size());
+        Eigen::MatrixXd a(f.size(), dim);  // int N_a n dA, per node
+        if (dim == 2) {
+          const Eigen::Vector2d t = mesh_.nodes.row(f[1]) - mesh_.nodes.row(f[0]);
+          a.row(0) = a.row(1) = 0.5 * Eigen::RowVector2d(t.y(), -t.x());
+        } else {
+          Eigen::Matrix<double, 4, 3> X;
+          for (int k = 0; k < 4; ++k) X.row(k) = mesh_.nodes.row(f[static_cast<std::size_t>(k)]);
+          a = quad_face_area_vectors(X);
+        }
+        const double sign = (facet_centre - centre).dot(a.colwise().sum().transpose()) < 0 ? -1.0 : 1.0;
+        for (std::size_t k = 0; k < f.size(); ++k)
+          dead_load_.segment(dim * f[k], dim) -= sign * pressure * a.row(static_cast<Eigen::Index>(k)).transpose();
       }
     }
   }

@@ -10,18 +10,30 @@ const std::vector<schema::Key>& fem_solid_keys() {
       section(
           "mesh", "the solid mesh",
           {
-              choice("type", {"rectangle", "box", "gmsh"},
-                     "built-in structured Q4 rectangle (2D), Hex8 box (3D), or a gmsh .msh file (2D)")
+              choice("type", {"rectangle", "box", "tube", "gmsh"},
+                     "built-in structured Q4 rectangle (2D), Hex8 box or tube (3D), or a gmsh .msh file (2D)")
                   .req(),
-              vector("origin", "lower-left (back) corner").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
+              vector("origin", "lower-left (back) corner; tube: the start of its axis (the axis is along +z)")
+                  .req()
+                  .only_when("type", {"rectangle", "box", "tube"})
+                  .in_unit("m"),
               vector("size", "lx, ly (, lz) (positive)").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
               int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
                   .req()
                   .only_when("type", {"rectangle"}),
               int_list("divisions", 3,
-                       "nx, ny, nz Hex8 cells (>= 1); face sets left, right (x), bottom, top (y), back, front (z)")
+                       "box: nx, ny, nz Hex8 cells (>= 1); face sets left, right (x), bottom, top (y), back, front "
+                       "(z). tube: n_theta (>= 3) around, n_r through the wall, n_z along; face sets inner, outer, "
+                       "start (z = origin), end")
                   .req()
-                  .only_when("type", {"box"}),
+                  .only_when("type", {"box", "tube"}),
+              number("inner_radius", "tube: inner radius").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
+              number("outer_radius", "tube: outer radius (> inner)")
+                  .req()
+                  .gt(0)
+                  .only_when("type", {"tube"})
+                  .in_unit("m"),
+              number("length", "tube: length along +z").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
               text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
               text("domain", "2D physical group of the solid; default: every quad group").only_when("type", {"gmsh"}),
           })
@@ -66,6 +78,12 @@ const std::vector<schema::Key>& fem_solid_keys() {
                    {
                        names("boundary", "facet set(s)").req(),
                        vector("traction", "force per reference length (2D) or area (3D)").req().in_unit("N/m"),
+                   })
+          .def("[]"),
+      section_list("pressures", "dead pressures: p times the outward normal of the reference configuration, inwards",
+                   {
+                       names("boundary", "facet set(s)").req(),
+                       number("pressure", "p (> 0 pushes into the solid)").req().in_unit("Pa"),
                    })
           .def("[]"),
       section_list("point_loads", "dead loads at the node nearest to a point",

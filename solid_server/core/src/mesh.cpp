@@ -98,6 +98,43 @@ SolidMesh box_mesh(const Eigen::Vector3d& origin, const Eigen::Vector3d& size, i
   return m;
 }
 
+SolidMesh tube_mesh(const Eigen::Vector3d& origin, double r_inner, double r_outer, double length, int n_theta, int n_r,
+                    int n_z) {
+  if (n_theta < 3 || n_r < 1 || n_z < 1)
+    throw std::invalid_argument("tube_mesh: need at least 3 cells around, 1 through the wall and 1 along");
+  if (!(r_inner > 0 && r_outer > r_inner && length > 0))
+    throw std::invalid_argument("tube_mesh: need 0 < inner radius < outer radius and a positive length");
+  SolidMesh m;
+  m.dim = 3;
+  m.nodes.resize(static_cast<Eigen::Index>((n_r + 1) * n_theta * (n_z + 1)), 3);
+  auto id = [n_r, n_theta](int i, int j, int k) { return (k * n_theta + (j % n_theta)) * (n_r + 1) + i; };
+  const double pi = 3.14159265358979323846;
+  for (int k = 0; k <= n_z; ++k)
+    for (int j = 0; j < n_theta; ++j)
+      for (int i = 0; i <= n_r; ++i) {
+        const double r = r_inner + (r_outer - r_inner) * i / n_r, theta = 2 * pi * j / n_theta;
+        m.nodes.row(id(i, j, k)) << origin(0) + r * std::cos(theta), origin(1) + r * std::sin(theta),
+            origin(2) + length * k / n_z;
+      }
+  // (r, theta, z) is right-handed: the box's node order with x -> r, y -> theta, z -> z.
+  for (int k = 0; k < n_z; ++k)
+    for (int j = 0; j < n_theta; ++j)
+      for (int i = 0; i < n_r; ++i)
+        m.cells.push_back({id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1),
+                           id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)});
+  for (int k = 0; k < n_z; ++k)
+    for (int j = 0; j < n_theta; ++j) {
+      m.facet_sets["inner"].push_back({id(0, j, k), id(0, j, k + 1), id(0, j + 1, k + 1), id(0, j + 1, k)});
+      m.facet_sets["outer"].push_back({id(n_r, j, k), id(n_r, j + 1, k), id(n_r, j + 1, k + 1), id(n_r, j, k + 1)});
+    }
+  for (int j = 0; j < n_theta; ++j)
+    for (int i = 0; i < n_r; ++i) {
+      m.facet_sets["start"].push_back({id(i, j, 0), id(i, j + 1, 0), id(i + 1, j + 1, 0), id(i + 1, j, 0)});
+      m.facet_sets["end"].push_back({id(i, j, n_z), id(i + 1, j, n_z), id(i + 1, j + 1, n_z), id(i, j + 1, n_z)});
+    }
+  return m;
+}
+
 void distort_interior(SolidMesh& mesh, double fraction, unsigned seed) {
   // Boundary nodes: those on any edge set.
   std::set<int> boundary;

@@ -131,4 +131,8 @@ Eigen::Matrix4d edge_mass(const Eigen::Vector2d& a, const Eigen::Vector2d& b, do
 // the share of each node of a constant traction (2x2 Gauss).
 Eigen::Vector4d quad_face_weights(const Eigen::Matrix<double, 4, 3>& X);
 
+// int N_a n dA over a bilinear quadrilateral face (row a; 2x2 Gauss), n the unit normal by
+// the right-hand rule of the node order: the share of each node of a unit pressure's force.
+Eigen::Matrix<double, 4, 3> quad_face_area_vectors(const Eigen::Matrix<double, 4, 3>& X);
+
 }  // namespace fsi::solid

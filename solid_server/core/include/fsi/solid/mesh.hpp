@@ -42,6 +42,14 @@ SolidMesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int
 // (k * (ny + 1) + j) * (nx + 1) + i.
 SolidMesh box_mesh(const Eigen::Vector3d& origin, const Eigen::Vector3d& size, int nx, int ny, int nz);
 
+// Structured Hex8 tube (a thick-walled cylinder) around the axis through `origin` along +z:
+// radii [r_inner, r_outer], length `length`, n_theta cells around, n_r through the wall, n_z
+// along. Face sets "inner" (r = r_inner), "outer", "start" (z = origin z), "end"; each face's
+// nodes counter-clockwise seen from outside the solid. Node (i, j, k) (i radial, j around, k
+// along; j periodic) has id (k * n_theta + j) * (n_r + 1) + i.
+SolidMesh tube_mesh(const Eigen::Vector3d& origin, double r_inner, double r_outer, double length, int n_theta, int n_r,
+                    int n_z);
+
 // Moves interior nodes of a mesh by a smooth-free random-like but deterministic
 // perturbation of up to `fraction` of the local spacing (for patch tests).
 void distort_interior(SolidMesh& mesh, double fraction, unsigned seed = 1);
