@@ -146,8 +146,10 @@ struct Coupler::State {
   double work_solid = 0, work_fluid = 0, work_fluid_on_solid = 0, work_uncancelled = 0;
   // M_G = H^T M_f H of the fluid's last solve (empty when the fluid does not send M_f).
   NodalMatrix mapped_mass;
-  // The parallel scheme's block scales of [d; v; F] (0 = not yet set).
+  // The parallel scheme's block scales of [d; v; F] (0 = not yet set), and the largest each
+  // has had: a scale never drops below kScaleFloor times it.
   double scale[3] = {0, 0, 0};
+  double peak[3] = {0, 0, 0};
 };
 
 // One coupling iteration's solves; the step accepts its last one.
@@ -708,6 +710,9 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   if (c.has("parallel.scale")) {
     const Eigen::VectorXd scale = c.vector("parallel.scale", 3);
     std::copy(scale.data(), scale.data() + 3, st.scale);
+    // Checkpoints before the floor: the scale is the largest known.
+    const Eigen::VectorXd peak = c.has("parallel.peak") ? c.vector("parallel.peak", 3) : scale;
+    std::copy(peak.data(), peak.data() + 3, st.peak);
   }
   r.accelerator->load(c, "accelerator.");
 }
@@ -971,7 +976,15 @@ Coupler::Update Coupler::parallel_iteration(Run& r, Step& step) {
 // x^(k+1) from the accelerator on the stacked [d; v; F], each block divided by its scale: the
 // size of the block (of x^(k) or of its new value, the larger) when it first is nonzero,
 // renewed at a step's first iteration when the size has moved by more than a factor 10 (the
-// accelerator then starts afresh: its secant pairs are in the old scaling).
+// accelerator then starts afresh: its secant pairs are in the old scaling). A scale never
+// drops below kScaleFloor times the largest it has had: a block that decays to rest (the
+// velocity of a steady state) would otherwise be measured against its own round-off, its
+// relative residual would stay O(1) however converged the step, and the quasi-Newton history
+// would fit noise.
+namespace {
+constexpr double kScaleFloor = 1e-3;  // of a block's largest scale (stacked_update)
+}  // namespace
+
 void Coupler::stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force) {
   const SolidStepResult& s = u.iterate.s;
   const Eigen::Index m = step.force.size();
@@ -981,9 +994,11 @@ void Coupler::stacked_update(Run& r, const Step& step, Update& u, const Eigen::V
   if (step.k == 1) {
     bool renewed = false;
     for (int b = 0; b < 3; ++b) {
-      const double size = std::max(x[b]->norm(), (*x[b] + res[b]).norm());
-      if (size > settings_.residual_floor && (scale[b] == 0 || size > 10 * scale[b] || size < 0.1 * scale[b]))
+      const double size = std::max({x[b]->norm(), (*x[b] + res[b]).norm(), kScaleFloor * r.state.peak[b]});
+      if (size > settings_.residual_floor && (scale[b] == 0 || size > 10 * scale[b] || size < 0.1 * scale[b])) {
         scale[b] = size, renewed = true;
+        r.state.peak[b] = std::max(r.state.peak[b], size);
+      }
     }
     if (renewed && step.n > 1) {
       r.accelerator = make_accelerator(settings_);
@@ -1221,6 +1236,7 @@ void Coupler::save_checkpoint(Run& r, int n, double t_np1) {
   c.put("iterations", static_cast<std::int64_t>(r.out.iterations));
   if (settings_.scheme == CouplingScheme::Parallel)
     c.put("parallel.scale", std::vector<double>(st.scale, st.scale + 3));
+  c.put("parallel.peak", std::vector<double>(st.peak, st.peak + 3));
   r.accelerator->save(c, "accelerator.");
   parts["coupler"] = c.serialize();
   nlohmann::json manifest = {{"scene", r.data.value("scene", std::string())},
