@@ -523,6 +523,14 @@ class FlagSolid:
         if not self.gamma > 0:
             return
         n_if = len(self.interface_nodes)
+        M_G = sp.coo_matrix((np.asarray(values, dtype=float), (rows, cols)), shape=(n_if, n_if)).tocsr()
+        if not getattr(self, "_mass_compared", False):  # once: the coupler's M_G against this solid's
+            self._mass_compared = True
+            scale = abs(self.M_G).max() if self.M_G.nnz else 0.0
+            diff = abs(M_G - self.M_G).max() if n_if else 0.0
+            self.log(f"the coupler's interface mass M_G (sum {M_G.sum():.6g}) against this solid's own "
+                     f"(sum {self.M_G.sum():.6g}): max |difference| {diff / scale if scale else diff:.1e} of its "
+                     f"largest entry (the same matrix only when the fluid's interface nodes are these)")
         self.M_fs = self._nodal_to_dofs(sp.coo_matrix((np.asarray(values) * self.gamma, (rows, cols)),
                                                       shape=(n_if, n_if)))
 
