@@ -26,6 +26,8 @@ coupler and a fluid that exerts no force (python/examples/fenics_solid/scenes/).
     node, node for node onto the plate; u_z(front) and u_x(x = 0.5) equal the closed form of
     uniaxial stress to 1e-8 relative (measured 3e-13);
   - checkpoints in 3D: a fork from the oldest checkpoint kept (step 2) reproduces step 3 exactly.
+  - the faces of the six face sets (Q1 hexahedra, P2 tetrahedra), built without the coupler:
+    counter-clockwise seen from outside, P2 midside nodes in gmsh order, mass = area;
   - dynamics (Newmark) with Algorithm 2's interface damping on the faces (gamma_N1 2000, 5
     steps): the same numbers and coupling iterations as solid_server's plain hex8 (the same
     element) to 1e-9 relative (measured 1.5e-15).
@@ -279,6 +281,46 @@ elif a.part == "block3d":
         else:
             check(False, f"block_3d fork: {len(steps)} checkpoints, exit {p.returncode} "
                          f"{(p.stderr + log_tail(fork))[-600:]}")
+    # The faces themselves, for every face set and cell (Q1 hexahedra: 4 nodes; P2 tetrahedra:
+    # 6 nodes in gmsh order), without the coupler: counter-clockwise seen from outside, the
+    # quadrilaterals convex in cyclic order, midside nodes at the middle of edges 0-1, 1-2, 2-0,
+    # and the interface mass summing to the area.
+    faces_check = r"""
+import sys, numpy as np
+sys.path.insert(0, sys.argv[1])
+import fem
+out = {"left": [-1, 0, 0], "right": [1, 0, 0], "bottom": [0, -1, 0], "top": [0, 1, 0], "back": [0, 0, -1],
+       "front": [0, 0, 1]}
+area = {"left": .125, "right": .125, "bottom": .25, "top": .25, "back": .5, "front": .5}
+for cell, degree in (("hexahedron", 1), ("tetrahedron", 2)):
+    for name, normal in out.items():
+        section = {"model": "fem", "mesh": {"type": "box", "origin": [0, 0, 0], "size": [1.0, 0.5, 0.25],
+                   "divisions": [3, 2, 1]}, "material": {"shear_modulus": 1e6, "poisson_ratio": 0.3},
+                   "density": 1.0, "analysis": "static", "interface": name}
+        m = fem.FlagSolid(section, 1.0, 0.0, element={"cell": cell, "degree": degree}, log=lambda *a: None)
+        bad = 0
+        for f in m.faces:
+            P = m.interface_xy[f]
+            k = len(f)
+            if k == 4:
+                bad += sum(np.dot(np.cross(P[(i + 1) % 4] - P[i], P[(i + 2) % 4] - P[(i + 1) % 4]), normal) <= 0
+                           for i in range(4))
+            else:
+                bad += np.dot(np.cross(P[1] - P[0], P[2] - P[0]), normal) <= 0
+                bad += sum(not np.allclose(P[3 + i], 0.5 * (P[a] + P[b])) for i, (a, b) in enumerate(((0, 1), (1, 2), (2, 0))))
+            bad += k != (4 if cell == "hexahedron" else 6)
+        if bad or abs(m.M_G.sum() - area[name]) > 1e-12:
+            print(f"{cell} P{degree} {name}: {bad} bad faces of {len(m.faces)}, M_G sum {m.M_G.sum()}")
+            sys.exit(1)
+print("ok")
+"""
+    p = subprocess.run([a.python, "-c", faces_check, str(SOLID.parent)], capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, DIJITSO_CACHE_DIR=os.environ.get(
+                           "DIJITSO_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache", "dijitso"))))
+    check(p.returncode == 0 and p.stdout.strip().endswith("ok"),
+          f"3D faces of the six face sets (Q1 hexahedra 4 nodes, P2 tetrahedra 6 nodes): counter-clockwise from "
+          f"outside, midside nodes in gmsh order, mass = area {(p.stdout + p.stderr)[-400:] if p.returncode else ''}")
+
     # Dynamics (Newmark) with Algorithm 2's interface damping (gamma_N1 M_G on the faces):
     # solid_server's plain hexahedron (hex8) is this solid's Q1, so the runs must agree.
     a2 = ["solid.analysis=dynamic", "solid.element=hex8", "coupling.gamma_n1=2000", "coupling.iterations.max=30",
