@@ -26,6 +26,8 @@ coupler and a fluid that exerts no force (python/examples/fenics_solid/scenes/).
     node, node for node onto the plate; u_z(front) and u_x(x = 0.5) equal the closed form of
     uniaxial stress to 1e-8 relative (measured 3e-13);
   - checkpoints in 3D: a fork from the oldest checkpoint kept (step 2) reproduces step 3 exactly.
+  - CSM1 extruded (scenes/csm1_3d.yaml), neo-Hookean, 20 x 2 x 1: Q1 hexahedra = solid_server's
+    hex8 to 1e-9 (measured ~1e-14 on 40 x 2 x 1);
   - the faces of the six face sets (Q1 hexahedra, P2 tetrahedra), built without the coupler:
     counter-clockwise seen from outside, P2 midside nodes in gmsh order, mass = area;
   - dynamics (Newmark) with Algorithm 2's interface damping on the faces (gamma_N1 2000, 5
@@ -339,6 +341,20 @@ print("ok")
     else:
         check(False, f"block_3d dynamic: exit {p.returncode} / {p2.returncode} "
                      f"{(p.stderr + p2.stderr + log_tail(work / 'block_a2_q1'))[-800:]}")
+    # The 3D laws: CSM1 extruded, neo-Hookean, Q1 hexahedra = solid_server's hex8 (20 x 2 x 1).
+    nh = ["solid.material.law=neo_hookean", "solid.mesh.divisions=[20, 2, 1]"]
+    p, _, _ = fsi_run(SCENES / "csm1_3d.yaml", work / "csm1_3d_nh_cpp", *nh, "solid.element=hex8")
+    p2, _, wall = fsi_run(SCENES / "csm1_3d.yaml", work / "csm1_3d_nh_q1", *nh, solid=f"{a.python} {SOLID}")
+    timings["csm1_3d_nh_q1"] = wall
+    if p.returncode == 0 and p2.returncode == 0:
+        ref, got = probes(work / "csm1_3d_nh_cpp"), probes(work / "csm1_3d_nh_q1")
+        d = max(abs(rel(got[k][-1], ref[k][-1])) for k in ("solid.A_x", "solid.A_y"))
+        check(d <= 1e-9 and got["solid.A_z"][-1] == 0.0,
+              f"csm1_3d neo-Hookean, FEniCS Q1 20 x 2 x 1 = solid_server hex8: A_y {got['solid.A_y'][-1]:.10e} vs "
+              f"{ref['solid.A_y'][-1]:.10e}, max relative difference {d:.1e} (<= 1e-9), {wall:.1f} s")
+    else:
+        check(False, f"csm1_3d neo-Hookean: exit {p.returncode} / {p2.returncode} "
+                     f"{(p.stderr + p2.stderr + log_tail(work / 'csm1_3d_nh_q1'))[-800:]}")
 else:
     out = work / "csm3_p2"
     p, summary, wall = fsi_run(SCENES / "csm3.yaml", out, solid=P2 + " --diagonal right", timeout=900)
