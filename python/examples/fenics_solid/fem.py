@@ -1,9 +1,11 @@
 """The finite-element part of the FEniCS solid: legacy DOLFIN (Debian's python3-dolfin), no
 protocol here (fenics_solid.py serves it through fsi.server).
 
-A 2D plane-strain, total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible
-neo-Hookean), Lagrange elements on triangles (P1, P2, ...) or quadrilaterals (Q1), full Newton
-with the consistent tangent that UFL derives, and the time schemes of solid_server:
+A total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible neo-Hookean), 2D
+plane strain or 3D, the dimension taken from the mesh (`rectangle` or `box`; one code path for
+both: Identity(dim), V.sub(c) for each component), Lagrange elements on triangles /
+tetrahedra (P1, P2, ...) or quadrilaterals / hexahedra (Q1), full Newton with the consistent
+tangent that UFL derives, and the time schemes of solid_server:
 
     M a_{n+1} + M_fs v_{n+1} + F_int(d_{n+1}) = F_dead + F_interface
 
@@ -13,10 +15,10 @@ with the consistent tangent that UFL derives, and the time schemes of solid_serv
     bdf1      v = (d - d_n) / dt, a = (v - v_n) / dt
 
 DOLFIN assembles the internal force F_int(d) and its tangent K(d) (the forms below), the mass
-matrix M and the dead loads (gravity, edge tractions) once; everything nodal (the coupler's
+matrix M and the dead loads (gravity, edge / face tractions) once; everything nodal (the coupler's
 interface force, the interface damping M_fs = gamma_N1 M_G, the time-scheme terms) is added to
 the assembled arrays with scipy, and the Newton systems are solved on the free dofs with
-SuperLU. Units: SI (m, kg, s, N, Pa), unit thickness.
+SuperLU. Units: SI (m, kg, s, N, Pa), unit thickness in 2D.
 """
 import io
 import math
