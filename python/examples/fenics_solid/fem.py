@@ -177,11 +177,14 @@ class FlagSolid:
         element = {k: v for k, v in (element or {}).items() if v is not None}
         fe = s.child("fenics")
         tensor, simplex = self.CELLS[dim]
+        if "cell" not in fe.data and element.get("cell", tensor) not in self.CELLS[dim]:
+            raise SceneError(f"--cell {element['cell']}: the mesh ('solid.mesh.type: {mtype}') is {dim}D, its cells are "
+                             f"{' or '.join(self.CELLS[dim])}")
         self.cell = fe.choice("cell", element.get("cell", tensor), self.CELLS[dim])
         self.tensor = self.cell == tensor
         self.degree = fe.integer("degree", element.get("degree", 1), minimum=1)
         if self.tensor and self.degree != 1:
-            raise SceneError(f"'solid.fenics.degree' must be 1 on {tensor}s (legacy DOLFIN cannot evaluate Q2 "
+            raise SceneError(f"'solid.fenics.degree' must be 1 on {tensor[:-2] + 'a' if dim == 3 else tensor + 's'} (legacy DOLFIN cannot evaluate Q2 "
                              f"at a probe point); use 'cell: {simplex}' for higher degrees")
         diagonal = fe.choice("diagonal", element.get("diagonal", "crossed"),
                              ("crossed", "right", "left", "right/left", "left/right"))
