@@ -109,9 +109,6 @@ class Section:
             raise SceneError(f"'{self.key(name)}' must be {what}, got {v!r}")
         return [float(x) for x in v]
 
-    def vector2(self, name, default=None, required=False):
-        return self.vector(name, 2, default, required)
-
     def choice(self, name, default, allowed):
         v = self.get(name, default)
         if v not in allowed:
