@@ -19,14 +19,30 @@ coupler and a fluid that exerts no force (python/examples/fenics_solid/scenes/).
     frequency of A's u_x and u_y over the last period within 1 % of Turek & Hron (measured
     within 0.35 %).
 
+--part block3d (ctest python.fenics_block3d):
+  - configs/block_3d.yaml (the 3D surrogate's plate of 4 x 4 quadrilaterals pressing an elastic
+    block on rollers) with the FEniCS solid's default 3D element (Q1 hexahedra, from
+    `mesh.type: box`): the interface goes over the sockets as 16 four-node faces, 3 values per
+    node, node for node onto the plate; u_z(front) and u_x(x = 0.5) equal the closed form of
+    uniaxial stress to 1e-8 relative (measured 3e-13);
+  - checkpoints in 3D: a fork from the oldest checkpoint kept (step 2) reproduces step 3 exactly.
+  - CSM1 extruded (scenes/csm1_3d.yaml), neo-Hookean, 20 x 2 x 1: Q1 hexahedra = solid_server's
+    hex8 to 1e-9 (measured ~1e-14 on 40 x 2 x 1);
+  - the faces of the six face sets (Q1 hexahedra, P2 tetrahedra), built without the coupler:
+    counter-clockwise seen from outside, P2 midside nodes in gmsh order, mass = area;
+  - dynamics (Newmark) with Algorithm 2's interface damping on the faces (gamma_N1 2000, 5
+    steps): the same numbers and coupling iterations as solid_server's plain hex8 (the same
+    element) to 1e-9 relative (measured 1.5e-15).
+
 Exit 77 (ctest: skipped) when the Python has no dolfin (scripts/install-deps.sh installs
 python3-dolfin).
 
-    test_fenics_solid.py --bin BUILD/bin --source SRC --python PYTHON --part static|csm3 WORK
+    test_fenics_solid.py --bin BUILD/bin --source SRC --python PYTHON --part static|csm3|block3d WORK
 """
 import argparse
 import csv
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -38,7 +54,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--bin", required=True)
 ap.add_argument("--source", required=True)
 ap.add_argument("--python", required=True)
-ap.add_argument("--part", choices=("static", "csm3"), required=True)
+ap.add_argument("--part", choices=("static", "csm3", "block3d"), required=True)
 ap.add_argument("work")
 a = ap.parse_args()
 SRC = Path(a.source).resolve()
@@ -219,6 +235,126 @@ if a.part == "static":
         check(p.returncode == 1 and "this configuration is" in reason,
               f"a checkpoint of another mesh is refused: exit {p.returncode}, "
               f"{[line for line in reason.splitlines() if 'checkpoint' in line][:1]}")
+elif a.part == "block3d":
+    # The closed form of configs/block_3d.yaml: uniaxial stress, St. Venant-Kirchhoff, dead load
+    # P = F / A = lambda Y (lambda^2 - 1) / 2, Y = 2 mu (1 + nu); lateral Green-Lagrange strain
+    # -nu times the axial one.
+    mu, nu, L, F_over_A = 1.0e6, 0.3, 0.2, -2.0e5
+    Y = 2 * mu * (1 + nu)
+    lo, hi = 0.5, 1.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if Y * mid * (mid * mid - 1) / 2 < F_over_A else (lo, mid)
+    stretch = 0.5 * (lo + hi)
+    uz = L * (stretch - 1)
+    ux = 1.0 * (math.sqrt(1 - nu * (stretch * stretch - 1)) - 1)  # x = 0.5: 1 m from the rollers x = -0.5
+    scene = SRC / "configs" / "block_3d.yaml"
+    out = work / "block_q1"
+    ck = ["time.checkpoint_every=1"]
+    p, summary, wall = fsi_run(scene, out, *ck, solid=f"{a.python} {SOLID}")
+    timings["block_q1"] = wall
+    if p.returncode != 0:
+        check(False, f"block_3d, FEniCS Q1: exit {p.returncode} {(p.stderr + log_tail(out))[-800:]}")
+    else:
+        pr = probes(out)
+        itf = summary.get("interface", {})
+        check(summary["servers"]["solid"]["name"].startswith("python fenics_solid.py")
+              and itf.get("solid_nodes") == 25 and itf.get("coincident_nodes") == 25 and itf.get("conforming"),
+              f"block_3d: the FEniCS faces meet the plate node for node (solid nodes {itf.get('solid_nodes')}, "
+              f"coincident {itf.get('coincident_nodes')}, conforming {itf.get('conforming')})")
+        expect = {"solid.corner_z": uz, "solid.centre_z": uz, "solid.corner_x": ux, "solid.corner_y": ux,
+                  "solid.centre_x": ux / 2, "solid.centre_y": ux / 2}
+        err = max(abs(rel(v, expect[k])) for k in expect for v in pr[k])
+        check(len(pr["time"]) == 3 and err < 1e-8,
+              f"block_3d, FEniCS Q1 4 x 4 x 1: u_z(front) {pr['solid.corner_z'][-1]:.9e} (closed form {uz:.9e}), "
+              f"u_x(x = 0.5) {pr['solid.corner_x'][-1]:.9e} (closed form {ux:.9e}), max relative error {err:.1e} "
+              f"(< 1e-8), {wall:.1f} s")
+        fork = work / "block_fork"
+        steps = sorted((out / "checkpoints").glob("step_*"))
+        p, _, wall = fsi_run(scene, fork, *ck, solid=f"{a.python} {SOLID}",
+                             extra=["--from", str(steps[0])] if steps else [])
+        if steps and p.returncode == 0:
+            B = probes(fork)
+            same = all(B[k] == pr[k][-len(B[k]):] for k in expect) and B["time"] == pr["time"][-len(B["time"]):]
+            rows = 3 - int(steps[0].name.split("_")[1])  # the coupler keeps the last checkpoints only
+            check(rows >= 1 and len(B["time"]) == rows and same,
+                  f"block_3d forked from {steps[0].name}: {len(B['time'])} row(s), equal to the uninterrupted run's: "
+                  f"{same}")
+        else:
+            check(False, f"block_3d fork: {len(steps)} checkpoints, exit {p.returncode} "
+                         f"{(p.stderr + log_tail(fork))[-600:]}")
+    # The faces themselves, for every face set and cell (Q1 hexahedra: 4 nodes; P2 tetrahedra:
+    # 6 nodes in gmsh order), without the coupler: counter-clockwise seen from outside, the
+    # quadrilaterals convex in cyclic order, midside nodes at the middle of edges 0-1, 1-2, 2-0,
+    # and the interface mass summing to the area.
+    faces_check = r"""
+import sys, numpy as np
+sys.path.insert(0, sys.argv[1])
+import fem
+out = {"left": [-1, 0, 0], "right": [1, 0, 0], "bottom": [0, -1, 0], "top": [0, 1, 0], "back": [0, 0, -1],
+       "front": [0, 0, 1]}
+area = {"left": .125, "right": .125, "bottom": .25, "top": .25, "back": .5, "front": .5}
+for cell, degree in (("hexahedron", 1), ("tetrahedron", 2)):
+    for name, normal in out.items():
+        section = {"model": "fem", "mesh": {"type": "box", "origin": [0, 0, 0], "size": [1.0, 0.5, 0.25],
+                   "divisions": [3, 2, 1]}, "material": {"shear_modulus": 1e6, "poisson_ratio": 0.3},
+                   "density": 1.0, "analysis": "static", "interface": name}
+        m = fem.FlagSolid(section, 1.0, 0.0, element={"cell": cell, "degree": degree}, log=lambda *a: None)
+        bad = 0
+        for f in m.faces:
+            P = m.interface_xy[f]
+            k = len(f)
+            if k == 4:
+                bad += sum(np.dot(np.cross(P[(i + 1) % 4] - P[i], P[(i + 2) % 4] - P[(i + 1) % 4]), normal) <= 0
+                           for i in range(4))
+            else:
+                bad += np.dot(np.cross(P[1] - P[0], P[2] - P[0]), normal) <= 0
+                bad += sum(not np.allclose(P[3 + i], 0.5 * (P[a] + P[b])) for i, (a, b) in enumerate(((0, 1), (1, 2), (2, 0))))
+            bad += k != (4 if cell == "hexahedron" else 6)
+        if bad or abs(m.M_G.sum() - area[name]) > 1e-12:
+            print(f"{cell} P{degree} {name}: {bad} bad faces of {len(m.faces)}, M_G sum {m.M_G.sum()}")
+            sys.exit(1)
+print("ok")
+"""
+    p = subprocess.run([a.python, "-c", faces_check, str(SOLID.parent)], capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, DIJITSO_CACHE_DIR=os.environ.get(
+                           "DIJITSO_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache", "dijitso"))))
+    check(p.returncode == 0 and p.stdout.strip().endswith("ok"),
+          f"3D faces of the six face sets (Q1 hexahedra 4 nodes, P2 tetrahedra 6 nodes): counter-clockwise from "
+          f"outside, midside nodes in gmsh order, mass = area {(p.stdout + p.stderr)[-400:] if p.returncode else ''}")
+
+    # Dynamics (Newmark) with Algorithm 2's interface damping (gamma_N1 M_G on the faces):
+    # solid_server's plain hexahedron (hex8) is this solid's Q1, so the runs must agree.
+    a2 = ["solid.analysis=dynamic", "solid.element=hex8", "coupling.gamma_n1=2000", "coupling.iterations.max=30",
+          "coupling.iterations.tolerance=1e-10", "time.end=0.5"]
+    p, _, _ = fsi_run(scene, work / "block_a2_cpp", *a2)
+    p2, _, wall = fsi_run(scene, work / "block_a2_q1", *a2, solid=f"{a.python} {SOLID}")
+    timings["block_a2_q1"] = wall
+    if p.returncode == 0 and p2.returncode == 0:
+        ref, got = probes(work / "block_a2_cpp"), probes(work / "block_a2_q1")
+        keys = [k for k in ref if k.startswith("solid.c")]
+        d = max(abs(rel(y, x)) for k in keys for x, y in zip(ref[k], got[k]))
+        its, its2 = ref["coupling.iterations"], got["coupling.iterations"]
+        check(len(got["time"]) == 5 and d <= 1e-9 and its == its2,
+              f"block_3d dynamic, Algorithm 2 (gamma_N1 2000): FEniCS Q1 = solid_server hex8, max relative difference "
+              f"{d:.1e} (<= 1e-9), coupling iterations {sum(its2):.0f} vs {sum(its):.0f}, {wall:.1f} s")
+    else:
+        check(False, f"block_3d dynamic: exit {p.returncode} / {p2.returncode} "
+                     f"{(p.stderr + p2.stderr + log_tail(work / 'block_a2_q1'))[-800:]}")
+    # The 3D laws: CSM1 extruded, neo-Hookean, Q1 hexahedra = solid_server's hex8 (20 x 2 x 1).
+    nh = ["solid.material.law=neo_hookean", "solid.mesh.divisions=[20, 2, 1]"]
+    p, _, _ = fsi_run(SCENES / "csm1_3d.yaml", work / "csm1_3d_nh_cpp", *nh, "solid.element=hex8")
+    p2, _, wall = fsi_run(SCENES / "csm1_3d.yaml", work / "csm1_3d_nh_q1", *nh, solid=f"{a.python} {SOLID}")
+    timings["csm1_3d_nh_q1"] = wall
+    if p.returncode == 0 and p2.returncode == 0:
+        ref, got = probes(work / "csm1_3d_nh_cpp"), probes(work / "csm1_3d_nh_q1")
+        d = max(abs(rel(got[k][-1], ref[k][-1])) for k in ("solid.A_x", "solid.A_y"))
+        check(d <= 1e-9 and got["solid.A_z"][-1] == 0.0,
+              f"csm1_3d neo-Hookean, FEniCS Q1 20 x 2 x 1 = solid_server hex8: A_y {got['solid.A_y'][-1]:.10e} vs "
+              f"{ref['solid.A_y'][-1]:.10e}, max relative difference {d:.1e} (<= 1e-9), {wall:.1f} s")
+    else:
+        check(False, f"csm1_3d neo-Hookean: exit {p.returncode} / {p2.returncode} "
+                     f"{(p.stderr + p2.stderr + log_tail(work / 'csm1_3d_nh_q1'))[-800:]}")
 else:
     out = work / "csm3_p2"
     p, summary, wall = fsi_run(SCENES / "csm3.yaml", out, solid=P2 + " --diagonal right", timeout=900)

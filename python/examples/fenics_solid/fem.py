@@ -1,9 +1,11 @@
 """The finite-element part of the FEniCS solid: legacy DOLFIN (Debian's python3-dolfin), no
 protocol here (fenics_solid.py serves it through fsi.server).
 
-A 2D plane-strain, total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible
-neo-Hookean), Lagrange elements on triangles (P1, P2, ...) or quadrilaterals (Q1), full Newton
-with the consistent tangent that UFL derives, and the time schemes of solid_server:
+A total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible neo-Hookean), 2D
+plane strain or 3D, the dimension taken from the mesh (`rectangle` or `box`; one code path for
+both: Identity(dim), V.sub(c) for each component), Lagrange elements on triangles /
+tetrahedra (P1, P2, ...) or quadrilaterals / hexahedra (Q1), full Newton with the consistent
+tangent that UFL derives, and the time schemes of solid_server:
 
     M a_{n+1} + M_fs v_{n+1} + F_int(d_{n+1}) = F_dead + F_interface
 
@@ -13,10 +15,10 @@ with the consistent tangent that UFL derives, and the time schemes of solid_serv
     bdf1      v = (d - d_n) / dt, a = (v - v_n) / dt
 
 DOLFIN assembles the internal force F_int(d) and its tangent K(d) (the forms below), the mass
-matrix M and the dead loads (gravity, edge tractions) once; everything nodal (the coupler's
+matrix M and the dead loads (gravity, edge / face tractions) once; everything nodal (the coupler's
 interface force, the interface damping M_fs = gamma_N1 M_G, the time-scheme terms) is added to
 the assembled arrays with scipy, and the Newton systems are solved on the free dofs with
-SuperLU. Units: SI (m, kg, s, N, Pa), unit thickness.
+SuperLU. Units: SI (m, kg, s, N, Pa), unit thickness in 2D.
 """
 import io
 import math
@@ -96,14 +98,16 @@ class Section:
                              + f", got {v!r}")
         return v
 
-    def vector2(self, name, default=None, required=False):
+    def vector(self, name, dim, default=None, required=False):
+        """A list of `dim` finite numbers ([x, y] in 2D, [x, y, z] in 3D)."""
         v = self.get(name, default, required)
         if isinstance(v, (list, tuple)):
             v = [_as_number(x) for x in v]
-        if (not isinstance(v, (list, tuple)) or len(v) != 2
+        if (not isinstance(v, (list, tuple)) or len(v) != dim
                 or any(isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) for x in v)):
-            raise SceneError(f"'{self.key(name)}' must be [x, y] (two finite numbers), got {v!r}")
-        return [float(v[0]), float(v[1])]
+            what = "[x, y] (two finite numbers)" if dim == 2 else "[x, y, z] (three finite numbers)"
+            raise SceneError(f"'{self.key(name)}' must be {what}, got {v!r}")
+        return [float(x) for x in v]
 
     def choice(self, name, default, allowed):
         v = self.get(name, default)
@@ -115,7 +119,7 @@ class Section:
         v = self.get(name, [])
         v = [v] if isinstance(v, str) else v
         if not isinstance(v, list) or not all(isinstance(x, str) for x in v):
-            raise SceneError(f"'{self.key(name)}' must be an edge set name or a list of names, got {v!r}")
+            raise SceneError(f"'{self.key(name)}' must be a facet set name or a list of names, got {v!r}")
         return v
 
     def child(self, name):
@@ -131,11 +135,19 @@ class Section:
 # -- the model ----------------------------------------------------------------------------------
 class FlagSolid:
     """The solid of one run: mesh, function space, forms, state (d, v, a of the last accepted
-    step and of the current solve) and the interface. All vectors are numpy arrays over the
-    DOLFIN dofs of V (2 components interleaved by DOLFIN's dof map, not necessarily x0 y0 x1
-    y1: use `ix`/`iy` to pick components)."""
+    step and of the current solve) and the interface, in 2D or 3D (`dim`, from the mesh:
+    `rectangle` or `box`). All vectors are numpy arrays over the DOLFIN dofs of V (`dim`
+    components interleaved by DOLFIN's dof map, not necessarily x0 y0 x1 y1: `comp[:, c]` are
+    the dofs of component c, node by node; `ix`, `iy`, `iz` the same by name)."""
 
-    EDGE_SETS = ("left", "right", "bottom", "top")
+    FACET_SETS = ("left", "right", "bottom", "top", "back", "front")  # x, y, z: the first 2 dim
+    COMPONENTS = ("x", "y", "z")
+    # the cells of each dimension: tensor-product (Q1) first, then simplices
+    CELLS = {2: ("quadrilateral", "triangle"), 3: ("hexahedron", "tetrahedron")}
+    # solid_server's `solid.element` per dimension: the plain one (this solid's default element,
+    # the same numbers) and its enhanced-strain variant (no enhanced strains here: refused in
+    # 2D as always; accepted with a line in the log in 3D, so that solid_server's 3D scenes run)
+    SERVER_ELEMENTS = {2: ("q4", "q4_eas"), 3: ("hex8", "h8_eas")}
 
     def __init__(self, section, dt, interface_damping, log=print, element=None):
         self.log = log
@@ -147,25 +159,45 @@ class FlagSolid:
         self.dt = dt
         self.gamma = float(interface_damping)
 
+        # 0. The dimension, from the mesh: rectangle (2D) or box (3D).
+        m = s.child("mesh")
+        mtype = m.get("type", "rectangle")
+        if mtype not in ("rectangle", "box"):
+            raise SceneError(f"'solid.mesh.type: {mtype}': this solid builds only 'rectangle' (2D) and 'box' (3D) "
+                             f"meshes")
+        dim = self.dim = 2 if mtype == "rectangle" else 3
+        self.facet_sets = self.FACET_SETS[:2 * dim]
+
         # 1. The discretisation: solid.fenics, else `element` (the server's command line), else
-        #    Q1 quadrilaterals with 2 x 2 Gauss points, solid_server's own element, so that a
-        #    scene written for solid_server gives its numbers.
+        #    Q1 quadrilaterals (hexahedra in 3D) with 2 x 2 (x 2) Gauss points, solid_server's own
+        #    element, so that a scene written for solid_server gives its numbers.
         element = {k: v for k, v in (element or {}).items() if v is not None}
         fe = s.child("fenics")
-        self.cell = fe.choice("cell", element.get("cell", "quadrilateral"), ("quadrilateral", "triangle"))
+        tensor, simplex = self.CELLS[dim]
+        if "cell" not in fe.data and element.get("cell", tensor) not in self.CELLS[dim]:
+            raise SceneError(f"--cell {element['cell']}: the mesh ('solid.mesh.type: {mtype}') is {dim}D, its cells are "
+                             f"{' or '.join(self.CELLS[dim])}")
+        self.cell = fe.choice("cell", element.get("cell", tensor), self.CELLS[dim])
+        self.tensor = self.cell == tensor
         self.degree = fe.integer("degree", element.get("degree", 1), minimum=1)
-        if self.cell == "quadrilateral" and self.degree != 1:
-            raise SceneError("'solid.fenics.degree' must be 1 on quadrilaterals (legacy DOLFIN cannot evaluate Q2 "
-                             "at a probe point); use 'cell: triangle' for higher degrees")
+        if self.tensor and self.degree != 1:
+            raise SceneError(f"'solid.fenics.degree' must be 1 on {tensor[:-2] + 'a' if dim == 3 else tensor + 's'} (legacy DOLFIN cannot evaluate Q2 "
+                             f"at a probe point); use 'cell: {simplex}' for higher degrees")
         diagonal = fe.choice("diagonal", element.get("diagonal", "crossed"),
                              ("crossed", "right", "left", "right/left", "left/right"))
         qdeg = fe.integer("quadrature_degree", element.get("quadrature_degree",
-                                                           2 if self.cell == "quadrilateral" else 2 * self.degree),
+                                                           2 if self.tensor else 2 * self.degree),
                           minimum=1)
         self.diagonal, self.quadrature_degree = diagonal, qdeg
         fe.check_all_used()
-        element = s.get("element", "q4")
-        if element != "q4":
+        plain, enhanced = self.SERVER_ELEMENTS[dim]
+        element = s.get("element", plain)
+        if element == enhanced and dim == 3:
+            # a 3D scene written for solid_server names its EAS element (configs/*_3d.yaml); the
+            # run goes on with this solid's element, said in the log (not the same numbers in bending)
+            log(f"'solid.element: {element}' is solid_server's enhanced-strain hexahedron; this solid uses its own "
+                f"element ({self.cell}, degree {self.degree}; 'solid.fenics'), without enhanced strains")
+        elif element != plain:
             raise SceneError(f"'solid.element: {element}' is solid_server's; the FEniCS solid's element is set by "
                              f"'solid.fenics' (cell, degree)")
         linear = s.get("linear_solver", "cholmod")
@@ -173,52 +205,58 @@ class FlagSolid:
             raise SceneError(f"'solid.linear_solver' must be cholmod, umfpack or superlu, got {linear!r} "
                              f"(this solid always uses SuperLU)")
 
-        # 2. Mesh: the structured rectangle of solid_server ('elements': cells per direction).
-        m = s.child("mesh")
-        mtype = m.get("type", "rectangle")
-        if mtype != "rectangle":
-            raise SceneError(f"'solid.mesh.type: {mtype}': this solid builds only 'rectangle' meshes")
-        x0, y0 = m.vector2("origin", required=True)
-        lx, ly = m.vector2("size", required=True)
-        if not (lx > 0 and ly > 0):
+        # 2. Mesh: the structured rectangle / box of solid_server ('elements' / 'divisions':
+        #    cells per direction).
+        origin = m.vector("origin", dim, required=True)
+        size = m.vector("size", dim, required=True)
+        if not all(x > 0 for x in size):
             raise SceneError("'solid.mesh.size' must be positive")
-        ne = m.get("elements", required=True)
-        if not (isinstance(ne, list) and len(ne) == 2 and all(isinstance(n, int) and not isinstance(n, bool) and n >= 1
-                                                               for n in ne)):
-            raise SceneError(f"'solid.mesh.elements' must be [nx, ny] (positive integers), got {ne!r}")
+        cells_key = "elements" if dim == 2 else "divisions"
+        ne = m.get(cells_key, required=True)
+        if not (isinstance(ne, list) and len(ne) == dim
+                and all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in ne)):
+            raise SceneError(f"'solid.mesh.{cells_key}' must be [{', '.join('nx ny nz'.split()[:dim])}] (positive "
+                             f"integers), got {ne!r}")
         m.check_all_used()
-        self.box = (x0, y0, x0 + lx, y0 + ly)
-        p0, p1 = df.Point(x0, y0), df.Point(x0 + lx, y0 + ly)
-        if self.cell == "quadrilateral":
+        self.box = tuple(origin) + tuple(o + l for o, l in zip(origin, size))
+        p0, p1 = df.Point(*origin), df.Point(*(o + l for o, l in zip(origin, size)))
+        if dim == 2 and self.tensor:
             self.mesh = df.RectangleMesh.create([p0, p1], ne, df.CellType.Type.quadrilateral)
-            family = "Q"
-        else:
+        elif dim == 2:
             self.mesh = df.RectangleMesh(p0, p1, ne[0], ne[1], diagonal)
-            family = "CG"
+        elif self.tensor:
+            self.mesh = df.BoxMesh.create([p0, p1], ne, df.CellType.Type.hexahedron)
+        else:  # each hexahedron cut into 6 tetrahedra
+            self.mesh = df.BoxMesh(p0, p1, ne[0], ne[1], ne[2])
+        family = "Q" if self.tensor else "CG"
         self.V = df.VectorFunctionSpace(self.mesh, family, self.degree)
         self.n = self.V.dim()
-        self.ix = np.asarray(self.V.sub(0).dofmap().dofs(), dtype=np.int64)
-        self.iy = np.asarray(self.V.sub(1).dofmap().dofs(), dtype=np.int64)
-        coords = self.V.tabulate_dof_coordinates().reshape(-1, 2)
-        self.node_xy = coords[self.ix]  # one row per node, the node of dofs ix[k], iy[k]
-        if not np.allclose(coords[self.iy], self.node_xy):
-            raise RuntimeError("the x and y dofs of V are not paired node by node")
+        # comp[k, c]: the dof of component c at node k (node k: the node of V.sub(0)'s k-th dof)
+        self.comp = np.stack([np.asarray(self.V.sub(c).dofmap().dofs(), dtype=np.int64) for c in range(dim)], axis=1)
+        self.ix, self.iy = self.comp[:, 0], self.comp[:, 1]
+        self.iz = self.comp[:, 2] if dim == 3 else None
+        coords = self.V.tabulate_dof_coordinates().reshape(-1, dim)
+        self.node_xy = coords[self.ix]  # one row per node (x, y (, z)), the node of dofs comp[k]
+        if not all(np.allclose(coords[self.comp[:, c]], self.node_xy) for c in range(1, dim)):
+            raise RuntimeError("the components' dofs of V are not paired node by node")
 
-        # Edge sets of the rectangle: facet markers 1..4 = left, right, bottom, top.
-        h = 1e-9 * max(lx, ly)
-        self.markers = df.MeshFunction("size_t", self.mesh, 1, 0)
-        for i, where in enumerate((f"near(x[0], {x0!r}, {h!r})", f"near(x[0], {x0 + lx!r}, {h!r})",
-                                   f"near(x[1], {y0!r}, {h!r})", f"near(x[1], {y0 + ly!r}, {h!r})")):
-            df.CompiledSubDomain(where + " && on_boundary").mark(self.markers, i + 1)
+        # Facet sets of the rectangle / box: markers 1..2 dim = left, right, bottom, top (, back, front).
+        h = 1e-9 * max(size)
+        self.markers = df.MeshFunction("size_t", self.mesh, dim - 1, 0)
+        for i, name in enumerate(self.facet_sets):
+            axis, value = i // 2, origin[i // 2] + (size[i // 2] if i % 2 else 0.0)
+            df.CompiledSubDomain(f"near(x[{axis}], {value!r}, {h!r}) && on_boundary").mark(self.markers, i + 1)
+
+        shape = "rectangle" if dim == 2 else "box"
 
         def edge_ids(key, names):
-            bad = [x for x in names if x not in self.EDGE_SETS]
+            bad = [x for x in names if x not in self.facet_sets]
             if bad:
-                raise SceneError(f"'solid.{key}': unknown edge set(s) {', '.join(bad)} (the rectangle has "
-                                 f"{', '.join(self.EDGE_SETS)})")
-            return [self.EDGE_SETS.index(x) + 1 for x in names]
+                raise SceneError(f"'solid.{key}': unknown {'edge' if dim == 2 else 'face'} set(s) {', '.join(bad)} "
+                                 f"(the {shape} has {', '.join(self.facet_sets)})")
+            return [self.facet_sets.index(x) + 1 for x in names]
 
-        # 3. Material (plane strain, 3D Lame relations) and density.
+        # 3. Material (3D Lame relations; plane strain in 2D) and density.
         mat = s.child("material")
         law = mat.choice("law", "saint_venant_kirchhoff", ("saint_venant_kirchhoff", "neo_hookean"))
         nu = mat.number("poisson_ratio", required=True)
@@ -258,21 +296,21 @@ class FlagSolid:
         # Material parameters as Constants, not literals: the compiled forms (dijitso's cache)
         # are then shared by every material, density and load.
         lam_c, mu_c, rho_c = df.Constant(lam), df.Constant(mu), df.Constant(rho)
-        I = df.Identity(2)
+        I = df.Identity(dim)
         H = df.grad(self.u)
         F = I + H
         E = 0.5 * (H + H.T + H.T * H)  # from H, not F^T F - I: full relative accuracy at tiny strains
         if law == "saint_venant_kirchhoff":
             W = 0.5 * lam_c * df.tr(E) ** 2 + mu_c * df.inner(E, E)
-        else:  # Bonet & Wood, plane strain: tr C includes C33 = 1
+        else:  # Bonet & Wood; in plane strain (2D) tr C includes C33 = 1
             J = df.det(F)
-            W = 0.5 * mu_c * (df.tr(F.T * F) + 1 - 3) - mu_c * df.ln(J) + 0.5 * lam_c * df.ln(J) ** 2
+            W = 0.5 * mu_c * (df.tr(F.T * F) + (3 - dim) - 3) - mu_c * df.ln(J) + 0.5 * lam_c * df.ln(J) ** 2
         f_int = df.derivative(W * dx, self.u, w)
         # compiled once (df.assemble of a UFL form would hash it again at every call)
         self.f_int_form, self.k_form = df.Form(f_int), df.Form(df.derivative(f_int, self.u, du))
         t0 = _time.perf_counter()
         self.M = self._csr(df.assemble(rho_c * df.inner(du, w) * dx))
-        gravity = s.vector2("gravity", [0.0, 0.0])
+        gravity = s.vector("gravity", dim, [0.0] * dim)
         dead = df.assemble(rho_c * df.inner(df.Constant(gravity), w) * dx).get_local()
         ds = df.Measure("ds", domain=self.mesh, subdomain_data=self.markers)
         tractions = s.get("tractions", []) or []
@@ -281,40 +319,69 @@ class FlagSolid:
         for i, t in enumerate(tractions):
             ts = Section(t, f"solid.tractions[{i}]")
             ids = edge_ids(f"tractions[{i}].boundary", ts.names("boundary"))
-            tr = ts.vector2("traction", required=True)
+            tr = ts.vector("traction", dim, required=True)
             ts.check_all_used()
-            for j in ids:  # force per reference length, consistent (int N^T t ds)
+            for j in ids:  # force per reference length (2D) / area (3D), consistent (int N^T t ds)
                 dead += df.assemble(df.inner(df.Constant(tr), w) * ds(j)).get_local()
         point_loads = s.get("point_loads", []) or []
         if not isinstance(point_loads, list):
             raise SceneError("'solid.point_loads' must be a list of {point, force}")
         for i, p in enumerate(point_loads):  # at the node nearest to the point, as solid_server
             ps = Section(p, f"solid.point_loads[{i}]")
-            k = int(np.argmin(np.sum((self.node_xy - ps.vector2("point", required=True)) ** 2, axis=1)))
-            fx, fy = ps.vector2("force", required=True)
+            k = int(np.argmin(np.sum((self.node_xy - ps.vector("point", dim, required=True)) ** 2, axis=1)))
+            force = ps.vector("force", dim, required=True)
             ps.check_all_used()
-            dead[self.ix[k]] += fx
-            dead[self.iy[k]] += fy
+            for c in range(dim):
+                dead[self.comp[k, c]] += force[c]
         self.f_dead = dead
 
-        # 6. Clamps: homogeneous Dirichlet on named edges, both components, by elimination.
+        # 6. Clamps: homogeneous Dirichlet on named facet sets, every component; supports: some
+        #    components only (solid_server's `supports: [{boundary, fixed: [x|y|z ...]}]`); by elimination.
         clamp = edge_ids("clamp", s.names("clamp"))
         fixed = set()
         for j in clamp:
-            fixed.update(df.DirichletBC(self.V, df.Constant((0.0, 0.0)), self.markers, j).get_boundary_values().keys())
+            fixed.update(df.DirichletBC(self.V, df.Constant((0.0,) * dim), self.markers, j).get_boundary_values().keys())
+        supports = s.get("supports", []) or []
+        if not isinstance(supports, list):
+            raise SceneError("'solid.supports' must be a list of {boundary, fixed}")
+        for i, sup in enumerate(supports):
+            ss = Section(sup, f"solid.supports[{i}]")
+            ids = edge_ids(f"supports[{i}].boundary", ss.names("boundary"))
+            components = ss.names("fixed")
+            ss.check_all_used()
+            if not components:
+                raise SceneError(f"'solid.supports[{i}].fixed' is required: some of {', '.join(self.COMPONENTS[:dim])}")
+            for name in components:
+                if name not in self.COMPONENTS[:dim]:
+                    raise SceneError(f"'solid.supports[{i}].fixed': '{name}' is not a component of a {dim}D mesh "
+                                     f"(give some of {', '.join(self.COMPONENTS[:dim])})")
+                c = self.COMPONENTS.index(name)
+                for j in ids:
+                    fixed.update(df.DirichletBC(self.V.sub(c), df.Constant(0.0), self.markers, j)
+                                 .get_boundary_values().keys())
         self.fixed = np.array(sorted(fixed), dtype=np.int64)
         mask = np.ones(self.n, dtype=bool)
         mask[self.fixed] = False
         self.free = np.flatnonzero(mask)
 
-        # 7. Interface: every dof node on the named edges; segments join consecutive nodes of
-        #    each facet (a P2 edge gives two segments, vertex-midpoint-vertex).
+        # 7. Interface: every dof node on the named facet sets. 2D: segments join consecutive
+        #    nodes of each edge (a P2 edge gives two segments, vertex-midpoint-vertex). 3D: each
+        #    facet is a face, counter-clockwise seen from outside (4 nodes on hexahedra; 3 on
+        #    tetrahedra, 6 for P2: corners, then the midpoints of edges 0-1, 1-2, 2-0).
         iface = s.names("interface")
-        self.interface_nodes, self.segments = self._interface(edge_ids("interface", iface))
+        ids = edge_ids("interface", iface)
+        if dim == 2:
+            self.interface_nodes, self.segments = self._interface(ids)
+            self.faces = None
+        else:
+            self.interface_nodes, self.faces = self._interface_faces(ids)
+            self.segments = None
         n_if = len(self.interface_nodes)
-        self.if_x, self.if_y = self.ix[self.interface_nodes], self.iy[self.interface_nodes]
+        self.if_dofs = self.comp[self.interface_nodes]  # n_if x dim
+        self.if_x, self.if_y = self.if_dofs[:, 0], self.if_dofs[:, 1]
         self.interface_xy = self.node_xy[self.interface_nodes]
-        self.M_G = self._polyline_mass()  # int N^T N over the segments, reference configuration
+        # int N^T N over the interface as sent (2D: the segments; 3D: the faces), reference configuration
+        self.M_G = self._polyline_mass() if dim == 2 else self._face_mass(ids)
         self.M_fs = self._nodal_to_dofs(self.M_G * self.gamma) if self.gamma > 0 and n_if else None
         if self.gamma > 0 and not n_if:
             raise SceneError("'solid.interface' is required when the coupler asks for interface damping")
@@ -327,7 +394,7 @@ class FlagSolid:
         for i, p in enumerate(probes):
             ps = Section(p, f"solid.probes[{i}]")
             name = ps.get("name", required=True)
-            point = ps.vector2("point", required=True)
+            point = ps.vector("point", dim, required=True)
             ps.check_all_used()
             weights = self._point_weights(point)
             if weights is None:
@@ -383,6 +450,59 @@ class FlagSolid:
             segments += [(local[a], local[b]) for a, b in zip(ks[:-1], ks[1:])]
         return np.array(nodes, dtype=np.int64), np.array(segments, dtype=np.int64).reshape(-1, 2)
 
+    def _interface_faces(self, ids):
+        """3D: (interface nodes as indices into node_xy, faces as lists of local indices), each
+        face counter-clockwise seen from outside (the normal by the right-hand rule points out
+        of the solid); a P2 triangle in gmsh order: corners, then the midpoints of 0-1, 1-2, 2-0."""
+        node_of_xdof = {int(d): k for k, d in enumerate(self.ix)}
+        dm = self.V.sub(0).dofmap()
+        X = self.mesh.coordinates()
+        self.mesh.init(2, 3)
+        nodes, local, faces = [], {}, []
+        for f in range(self.mesh.num_facets()):
+            if self.markers[f] not in ids:
+                continue
+            facet = df.Facet(self.mesh, f)
+            ks = [node_of_xdof[int(d)] for d in dm.entity_closure_dofs(self.mesh, 2, [f])]
+            xyz = self.node_xy[ks]
+            corners_xyz = X[facet.entities(0)]
+            # the corners among the facet's nodes (the vertices), the others are mid-edge nodes (P2)
+            corners = [ks[int(np.argmin(np.sum((xyz - p) ** 2, axis=1)))] for p in corners_xyz]
+            centre = corners_xyz.mean(axis=0)
+            cell = df.Cell(self.mesh, int(facet.entities(3)[0]))
+            outward = centre - X[cell.entities(0)].mean(axis=0)
+            # order the corners by angle about the outward normal (convex, planar facets)
+            e1 = corners_xyz[0] - centre
+            e2 = np.cross(outward, e1)
+            rel = self.node_xy[corners] - centre
+            angle = np.arctan2(rel @ e2, rel @ e1)
+            corners = [corners[i] for i in np.argsort(angle, kind="stable")]
+            face = list(corners)
+            if len(ks) > len(corners):  # P2 triangle: the node at the middle of each edge
+                if len(corners) != 3 or len(ks) != 6:
+                    raise RuntimeError(f"a facet with {len(ks)} nodes: only P1/P2 triangles and Q1 quadrilaterals")
+                for a, b in ((0, 1), (1, 2), (2, 0)):
+                    mid = 0.5 * (self.node_xy[corners[a]] + self.node_xy[corners[b]])
+                    face.append(ks[int(np.argmin(np.sum((xyz - mid) ** 2, axis=1)))])
+            for k in face:
+                if k not in local:
+                    local[k] = len(nodes)
+                    nodes.append(k)
+            faces.append([local[k] for k in face])
+        return np.array(nodes, dtype=np.int64), faces
+
+    def _face_mass(self, ids):
+        """3D: the consistent mass of the interface faces, int N^T N dA (reference configuration),
+        assembled by DOLFIN on the interface facets, as a scalar matrix on interface nodes."""
+        n_if = len(self.interface_nodes)
+        if not n_if:
+            return sp.csr_matrix((0, 0))
+        w, du = df.TestFunction(self.V), df.TrialFunction(self.V)
+        ds = df.Measure("ds", domain=self.mesh, subdomain_data=self.markers,
+                        metadata={"quadrature_degree": 2 * self.degree})
+        M = self._csr(df.assemble(sum(df.inner(du, w) * ds(j) for j in ids)))
+        return M[self.if_x][:, self.if_x].tocsr()  # the x block: the same for every component
+
     def _polyline_mass(self):
         n = len(self.interface_nodes)
         rows, cols, vals = [], [], []
@@ -394,38 +514,60 @@ class FlagSolid:
         return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
     def _nodal_to_dofs(self, nodal):
-        """A scalar matrix on interface nodes -> the n x n matrix acting on x and y alike."""
+        """A scalar matrix on interface nodes -> the n x n matrix acting on every component alike."""
         c = sp.coo_matrix(nodal)
-        rows = np.concatenate([self.if_x[c.row], self.if_y[c.row]])
-        cols = np.concatenate([self.if_x[c.col], self.if_y[c.col]])
-        return sp.csr_matrix((np.concatenate([c.data, c.data]), (rows, cols)), shape=(self.n, self.n))
+        rows = np.concatenate([self.if_dofs[c.row, k] for k in range(self.dim)])
+        cols = np.concatenate([self.if_dofs[c.col, k] for k in range(self.dim)])
+        return sp.csr_matrix((np.concatenate([c.data] * self.dim), (rows, cols)), shape=(self.n, self.n))
 
     def set_interface_mass(self, rows, cols, values):
         """Algorithm 2: M_fs = gamma_N1 * M_G with the coupler's M_G (interface nodes)."""
         if not self.gamma > 0:
             return
         n_if = len(self.interface_nodes)
+        M_G = sp.coo_matrix((np.asarray(values, dtype=float), (rows, cols)), shape=(n_if, n_if)).tocsr()
+        if not getattr(self, "_mass_compared", False):  # once: the coupler's M_G against this solid's
+            self._mass_compared = True
+            scale = abs(self.M_G).max() if self.M_G.nnz else 0.0
+            diff = abs(M_G - self.M_G).max() if n_if else 0.0
+            self.log(f"the coupler's interface mass M_G (sum {M_G.sum():.6g}) against this solid's own "
+                     f"(sum {self.M_G.sum():.6g}): max |difference| {diff / scale if scale else diff:.1e} of its "
+                     f"largest entry (the same matrix only when the fluid's interface nodes are these)")
         self.M_fs = self._nodal_to_dofs(sp.coo_matrix((np.asarray(values) * self.gamma, (rows, cols)),
                                                       shape=(n_if, n_if)))
 
     def _point_weights(self, point):
-        """[(dof, weight)] with u(point) = sum weight * u[dof] per component, or None if outside."""
+        """Per component c, [(dof, weight)] with u_c(point) = sum weight * u[dof], or None if outside."""
         x = np.array(point, dtype=float)
-        tree = self.mesh.bounding_box_tree()
+        dim = self.dim
         dm = self.V.dofmap()
-        if self.cell == "triangle":
+        if not self.tensor:
+            tree = self.mesh.bounding_box_tree()
             c = tree.compute_first_entity_collision(df.Point(*x))
             if c >= self.mesh.num_cells():
                 return None
             cell = df.Cell(self.mesh, c)
             basis = self.V.element().evaluate_basis_all(x, cell.get_vertex_coordinates(), 0)
-            basis = basis.reshape(-1, 2)  # per cell dof: (value x, value y)
+            basis = basis.reshape(-1, dim)  # per cell dof: (value x, value y (, value z))
             dofs = dm.cell_dofs(c)
-            wx = [(int(d), float(b[0])) for d, b in zip(dofs, basis) if b[0] != 0]
-            wy = [(int(d), float(b[1])) for d, b in zip(dofs, basis) if b[1] != 0]
-            return wx, wy
-        # Q1: invert the bilinear map of each cell (DOLFIN's vertex order: (0,0), (1,0), (0,1), (1,1))
-        v2d = df.vertex_to_dof_map(self.V).reshape(-1, 2)
+            return tuple([(int(d), float(b[k])) for d, b in zip(dofs, basis) if b[k] != 0] for k in range(dim))
+        # Q1: invert the multilinear map of each cell (DOLFIN's vertex order is the tensor
+        # product: vertex a sits at xi_k = bit k of a, i.e. (0,0), (1,0), (0,1), (1,1) in 2D,
+        # then the same at xi_2 = 1 in 3D; bilinear legacy DOLFIN cannot do this, nor a bounding
+        # box collision on non-simplex cells)
+        v2d = df.vertex_to_dof_map(self.V).reshape(-1, dim)
+        bits = np.array([[(a >> k) & 1 for k in range(dim)] for a in range(2 ** dim)])
+
+        def shape(xi):
+            f = np.where(bits == 1, xi, 1 - xi)  # per vertex and direction: xi_k or 1 - xi_k
+            N = np.ones(2 ** dim)
+            dN = np.ones((2 ** dim, dim))
+            for k in range(dim):
+                N = N * f[:, k]
+                for j in range(dim):
+                    dN[:, j] = dN[:, j] * (f[:, k] if k != j else 2 * bits[:, k] - 1)
+            return N, dN
+
         best = None
         for c in range(self.mesh.num_cells()):
             verts = self.mesh.cells()[c]
@@ -433,10 +575,9 @@ class FlagSolid:
             lo, hi = X.min(axis=0), X.max(axis=0)
             if np.any(x < lo - 1e-9 * (hi - lo).max()) or np.any(x > hi + 1e-9 * (hi - lo).max()):
                 continue
-            xi = np.array([0.5, 0.5])
+            xi = np.full(dim, 0.5)
             for _ in range(20):
-                N = np.array([(1 - xi[0]) * (1 - xi[1]), xi[0] * (1 - xi[1]), (1 - xi[0]) * xi[1], xi[0] * xi[1]])
-                dN = np.array([[-(1 - xi[1]), -(1 - xi[0])], [1 - xi[1], -xi[0]], [-xi[1], 1 - xi[0]], [xi[1], xi[0]]])
+                N, dN = shape(xi)
                 r = N @ X - x
                 Jm = X.T @ dN
                 step = np.linalg.solve(Jm, r)
@@ -449,15 +590,14 @@ class FlagSolid:
         if best is None or best[0] > 0.5 + 1e-9:
             return None
         _, verts, xi = best
-        N = [(1 - xi[0]) * (1 - xi[1]), xi[0] * (1 - xi[1]), (1 - xi[0]) * xi[1], xi[0] * xi[1]]
-        return ([(int(v2d[v, 0]), float(w)) for v, w in zip(verts, N)],
-                [(int(v2d[v, 1]), float(w)) for v, w in zip(verts, N)])
+        N, _ = shape(xi)
+        return tuple([(int(v2d[v, k]), float(w)) for v, w in zip(verts, N)] for k in range(dim))
 
     def probe_values(self, d):
         out = {}
-        for name, (wx, wy) in self.probes:
-            out[name + "_x"] = float(sum(w * d[i] for i, w in wx))
-            out[name + "_y"] = float(sum(w * d[i] for i, w in wy))
+        for name, weights in self.probes:
+            for k, wk in enumerate(weights):
+                out[f"{name}_{self.COMPONENTS[k]}"] = float(sum(w * d[i] for i, w in wk))
         return out
 
     # -- Newton ------------------------------------------------------------------------------
@@ -519,7 +659,7 @@ class FlagSolid:
 
     # -- one step, from the last accepted state -------------------------------------------------
     def solve(self, dt, interface_force):
-        """Solve the step for this interface force (2 per interface node, interleaved), from
+        """Solve the step for this interface force (dim per interface node, interleaved), from
         the accepted state. Returns the interface displacement and velocity (interleaved)."""
         t0 = _time.perf_counter()
         try:
@@ -529,8 +669,8 @@ class FlagSolid:
 
     def _solve(self, dt, interface_force):
         f = self.f_dead.copy()
-        f[self.if_x] += interface_force[0::2]
-        f[self.if_y] += interface_force[1::2]
+        for c in range(self.dim):
+            f[self.if_dofs[:, c]] += interface_force[c::self.dim]
         self.f = f
         self.newton_iterations = 0
         d_n, v_n, a_n = self.d_n, self.v_n, self.a_n
@@ -569,8 +709,9 @@ class FlagSolid:
         return self.interface_values(d), self.interface_values(v)
 
     def interface_values(self, x):
-        out = np.empty(2 * len(self.interface_nodes))
-        out[0::2], out[1::2] = x[self.if_x], x[self.if_y]
+        out = np.empty(self.dim * len(self.interface_nodes))
+        for c in range(self.dim):
+            out[c::self.dim] = x[self.if_dofs[:, c]]
         return out
 
     def accept(self):

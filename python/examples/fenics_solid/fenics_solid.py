@@ -1,13 +1,18 @@
 #!/usr/bin/env python3
 """A FEniCS (legacy DOLFIN) finite-element solid served through fsi.server: it replaces
-solid_server in any scene whose solid is the Turek-Hron flag (a clamped rectangle).
+solid_server in any scene whose solid is a structured rectangle (2D, e.g. the Turek-Hron flag)
+or box (3D: the dimension is the mesh's).
 
     fsi run python/examples/fenics_solid/scenes/csm1.yaml --out runs/csm1_fenics \\
         --solid-command "python3 python/examples/fenics_solid/fenics_solid.py --cell triangle --degree 2"
+    fsi run configs/block_3d.yaml --out runs/block_3d_fenics \\
+        --solid-command "python3 python/examples/fenics_solid/fenics_solid.py"
 
-It reads the same `solid` section as solid_server's `model: fem` (mesh rectangle, material,
-density, gravity, analysis, time_scheme, load_steps, clamp, interface, tractions, point_loads,
-probes, newton, output_every), so one scene runs with either solid. The element is this
+It reads the same `solid` section as solid_server's `model: fem` (mesh rectangle or box,
+material, density, gravity, analysis, time_scheme, load_steps, clamp, supports, interface,
+tractions, point_loads, probes, newton, output_every), so one scene runs with either solid.
+In 3D the interface is sent as faces (dimension 3): Q1 hexahedra (the default on a box) give
+4-node faces, `--cell tetrahedron --degree 1|2` 3- or 6-node triangles. The element is this
 solid's own choice: `--cell triangle --degree 2` (accurate on coarse meshes), or a section
 `solid.fenics: {cell, degree, diagonal, quadrature_degree}` in a scene written for it alone
 (solid_server refuses the key). By default it uses solid_server's element (Q1, 2 x 2 Gauss
@@ -77,14 +82,18 @@ class FenicsSolid(fs.Solid):
             raise fs.InvalidArgument(f"{self.scene_path}: {e}") from None
         m = self.model
         self.output_dir = output_dir
-        _log(f"{m.cell} mesh ({m.diagonal if m.cell == 'triangle' else 'structured'}), {m.mesh.num_cells()} cells, "
-             f"{'Q' if m.cell == 'quadrilateral' else 'P'}{m.degree}, quadrature degree {m.quadrature_degree}, "
+        _log(f"{m.dim}D {m.cell} mesh ({m.diagonal if m.cell == 'triangle' else 'structured'}), "
+             f"{m.mesh.num_cells()} cells, "
+             f"{'Q' if m.tensor else 'P'}{m.degree}, quadrature degree {m.quadrature_degree}, "
              f"{m.n} dofs ({m.free.size} free), "
              f"{m.law}, mu {m.mu:.6g}, lambda {m.lam:.6g}, {m.analysis}"
              + ("" if m.scheme == "static" else f" {m.scheme}") + f", {len(m.interface_nodes)} interface nodes, "
              f"gamma_N1 {interface_damping:g}; set up in {time.perf_counter() - t0:.2f} s")
-        return fs.Interface(coordinates=m.interface_xy.reshape(-1), segments=m.segments.reshape(-1),
-                            node_ids=m.ix[m.interface_nodes])
+        if m.dim == 2:
+            return fs.Interface(coordinates=m.interface_xy.reshape(-1), segments=m.segments.reshape(-1),
+                                node_ids=m.ix[m.interface_nodes])
+        return fs.Interface(coordinates=m.interface_xy.reshape(-1), faces=m.faces, node_ids=m.ix[m.interface_nodes],
+                            dimension=3)
 
     def set_interface_mass(self, matrix):
         """SolveStep.interface_mass (Algorithm 2): M_fs = gamma_N1 * M_G from now on."""
@@ -130,12 +139,14 @@ class FenicsSolid(fs.Solid):
 def main():
     parser = fs.argument_parser(__doc__.splitlines()[0])
     g = parser.add_argument_group("the element (defaults of the scene's solid.fenics, which wins when present)")
-    g.add_argument("--cell", choices=("quadrilateral", "triangle"), help="default quadrilateral")
-    g.add_argument("--degree", type=int, help="Lagrange degree (default 1; quadrilaterals: 1 only)")
+    g.add_argument("--cell", choices=("quadrilateral", "triangle", "hexahedron", "tetrahedron"),
+                   help="default quadrilateral (2D, mesh type rectangle) / hexahedron (3D, mesh type box)")
+    g.add_argument("--degree", type=int, help="Lagrange degree (default 1; quadrilaterals and hexahedra: 1 only)")
     g.add_argument("--diagonal", choices=("crossed", "right", "left", "right/left", "left/right"),
-                   help="how the rectangles of solid.mesh.elements are cut into triangles (default crossed)")
-    g.add_argument("--quadrature-degree", type=int, help="default 2 on quadrilaterals (2 x 2 Gauss), 2 x degree "
-                                                           "on triangles")
+                   help="how the rectangles of solid.mesh.elements are cut into triangles (default crossed; "
+                        "2D only: a box's cells are cut into 6 tetrahedra each)")
+    g.add_argument("--quadrature-degree", type=int, help="default 2 on quadrilaterals / hexahedra (2 x 2 (x 2) "
+                                                           "Gauss), 2 x degree on triangles / tetrahedra")
     args = parser.parse_args()
     element = {"cell": args.cell, "degree": args.degree, "diagonal": args.diagonal,
                "quadrature_degree": args.quadrature_degree}
