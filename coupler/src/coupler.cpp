@@ -175,6 +175,7 @@ struct Coupler::Step {
   Eigen::VectorXd d_iter_prev, v_iter_prev;  // the last iteration's solid interface state
   Eigen::VectorXd x_d, x_v;                  // parallel: the interface state x^(k) the fluid is given
   double gap = 0;                            // parallel: |d^(k+1) - d^(k)| / |d^(k+1)| of the last update
+  std::vector<double> history;               // the residual of every iteration (stall detection)
   Iterate last;
 };
 
@@ -467,6 +468,21 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
         "non-conforming interface: {} of the {} fluid nodes coincide with one of the {} solid nodes "
         "(within {:.3g} m), max gap to the solid's interface {:.3g} m: H interpolates",
         map_.coincident_nodes(), fluid_interface.nodes(), ns, map_.coincidence_tolerance(), map_.max_gap());
+  }
+  // Algorithm 2 far above the solid's interface impedance Z_s = m_s / |Gamma| / dt: converged
+  // iterations contract by about 1 - beta (Z_s + Z_f) / (Z_s + gamma_N1), so their number
+  // grows like gamma_N1 / Z_s.
+  impedance_ratio_ = 0;
+  if (implicit && gamma > 0 && solid_interface_.mass_per_area > 0) {
+    const double z_s = solid_interface_.mass_per_area / time.dt;
+    impedance_ratio_ = gamma / z_s;
+    data["coupling_estimate"] = {{"solid_impedance", z_s}, {"gamma_over_impedance", impedance_ratio_}};
+    if (impedance_ratio_ > 10 && settings_.max_iterations > 1)
+      log->warn(
+          "Algorithm 2: gamma_N1 = {:.4g} is {:.3g} times the solid's interface impedance m_s / |Gamma| / dt = "
+          "{:.4g}: converged coupling iterations contract by about 1 - beta (Z_s + Z_f) / (Z_s + gamma_N1), so expect "
+          "their number to grow like that ratio (coupling.robin_auto: solid sets gamma_N1 to the impedance)",
+          gamma, impedance_ratio_, z_s);
   }
   consistent_damping_ = implicit && gamma > 0 && settings_.robin_mass == RobinMass::Consistent;
   if (consistent_damping_ && !solid_.supports_interface_mass()) {
@@ -1071,6 +1087,7 @@ bool Coupler::finish_iteration(Run& r, Step& step, const Update& u, bool met) {
   if (settings_.measures.empty()) return false;
   // Parallel: the fluid's interface state must have converged too (below the measures' limit).
   if (met && (!parallel || u.gap < parallel_gap_limit())) return true;
+  check_stall(step, residual);
   // Geometric growth keeps the relative residual constant: watch the absolute change.
   if (k > 1 && (residual > settings_.divergence_factor * std::max(step.first_residual, settings_.residual_floor) ||
                 change > settings_.divergence_factor * std::max(step.first_change, settings_.residual_floor)))
@@ -1081,6 +1098,46 @@ bool Coupler::finish_iteration(Run& r, Step& step, const Update& u, bool met) {
                            parallel ? "|x^(k+1) - x^(k)| (scaled [d; v; F])" : "|F^(k+1) - F^(k)|", step.first_change,
                            change, step.first_residual, residual, n, k, settings_.relaxation)};
   return false;
+}
+
+// A stalled iteration: over the last kStallWindow iterations the residual fell so slowly that,
+// at that rate, the tolerance is out of reach within coupling.iterations.max. The run would end
+// there as unconverged anyway; ending it now says why, and before a solver is handed the
+// iterates of a scheme that barely contracts (Algorithm 2 far above the solid's impedance
+// contracts by about 1 - beta (Z_s + Z_f) / (Z_s + gamma_N1) per iteration).
+void Coupler::check_stall(Step& step, double residual) const {
+  constexpr int kStallWindow = 20;
+  step.history.push_back(residual);
+  const int k = step.k;
+  // The serial scheme only: the parallel scheme's stacked residual is not monotone (the Jacobi
+  // lag between d, v and F lets it grow for tens of iterations near the relaxation limit
+  // before it converges).
+  if (settings_.scheme != CouplingScheme::Serial || !settings_.stop_if_not_converged || k <= kStallWindow ||
+      !(residual > 0))
+    return;
+  const double then = step.history[static_cast<std::size_t>(k - 1 - kStallWindow)];
+  const double rate = then > 0 ? std::pow(residual / then, 1.0 / kStallWindow) : 1.0;
+  double needed = 0;  // iterations to meet every measure at this rate
+  for (std::size_t i = 0; i < settings_.measures.size(); ++i)
+    if (!(step.values[i] < settings_.measures[i].limit))
+      needed = std::max(needed, rate < 1 ? std::log(step.values[i] / settings_.measures[i].limit) / -std::log(rate)
+                                         : std::numeric_limits<double>::infinity());
+  const int remaining = settings_.max_iterations - k;
+  if (!(needed > 2.0 * remaining)) return;
+  std::string hint;
+  if (impedance_ratio_ > 10)
+    hint = fmt::format(
+        "; Algorithm 2's gamma_N1 is {:.3g} times the solid's interface impedance m_s / |Gamma| / dt: a smaller "
+        "gamma_N1 (coupling.robin_auto: solid sets it to the impedance) contracts faster",
+        impedance_ratio_);
+  throw Stop{
+      "diverged",
+      fmt::format("coupling stalled at step {} iteration {}: the residual fell from {:.3e} to {:.3e} over the last "
+                  "{} iterations ({:.4f} per iteration); at that rate the tolerance needs {} more, {} remain "
+                  "(coupling.iterations.max){}",
+                  step.n, k, then, residual, kStallWindow, rate,
+                  std::isfinite(needed) ? fmt::format("{:.0f}", std::ceil(needed)) : std::string("infinitely many"),
+                  remaining, hint)};
 }
 
 void Coupler::check_unconverged(const Step& step) const {

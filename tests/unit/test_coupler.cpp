@@ -312,6 +312,37 @@ void expect_monolithic_added_mass(const std::vector<double>& dx, const std::stri
   }
 }
 
+// Algorithm 2 far above the solid's interface impedance Z_s = m / |Gamma| / dt = 100: with
+// gamma_N1 = 1e5 (1000 Z_s) the iterations barely contract, and 1e-10 is out of reach of the
+// 300 allowed. The run ends as stalled once the 20-iteration window shows it, naming the rate
+// and the ratio, not after 300 iterations as "not reached"; at gamma_N1 = 10 Z_s it converges.
+TEST(AddedMass, AStalledIterationEndsNamedWithTheImpedanceRatio) {
+  const std::vector<std::string> common = {"coupling.algorithm=2",
+                                           "coupling.relaxation=1",
+                                           "coupling.iterations.max=300",
+                                           "coupling.iterations.tolerance=1e-10",
+                                           "time.end=0.2",
+                                           "time.dt=0.01",
+                                           "solid.mass=1",
+                                           "solid.damping=0.5",
+                                           "solid.stiffness=4",
+                                           "fluid.added_mass=10",
+                                           "fluid.force=1"};
+  auto stalled_set = common;
+  stalled_set.push_back("coupling.gamma_n1=1e5");
+  const auto stalled = run_scene(stalled_set);
+  EXPECT_EQ(stalled.outcome.status, "diverged");
+  EXPECT_EQ(stalled.outcome.steps, 0);
+  const std::string& why = stalled.outcome.reason;
+  EXPECT_NE(why.find("coupling stalled at step 1 iteration"), std::string::npos) << why;
+  EXPECT_NE(why.find("gamma_N1 is 1e+03 times the solid's interface impedance"), std::string::npos) << why;
+  EXPECT_GT(stalled.iteration_rows.size(), 20u);
+  EXPECT_LT(stalled.iteration_rows.size(), 100u);  // not the 300 of coupling.iterations.max
+  auto fine_set = common;
+  fine_set.push_back("coupling.gamma_n1=1000");
+  EXPECT_EQ(run_scene(fine_set).outcome.status, "completed");
+}
+
 TEST(AddedMass, ConvergedSolutionIsTheMonolithicOne) {
   // Converged coupling iterations solve (m + m_a) a + c v + k d = F exactly (BDF1).
   const auto run = run_scene({"coupling.algorithm=1", "coupling.relaxation=0.1", "coupling.iterations.max=500",

@@ -108,6 +108,7 @@ class Coupler {
   // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
   void describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface);
   void check_gap(nlohmann::json& data, const InterfaceMeshData& fluid_interface) const;
+  void check_stall(Step& step, double residual) const;
   // 2. The state the first step starts from: a checkpoint (resume, fork) or the initial one.
   void start_state(Run& r);
   void find_restart(Run& r);  // --resume's checkpoint, forked_from.json
@@ -137,6 +138,7 @@ class Coupler {
   void write_output(Run& r, const StepInfo& info, const InterfaceFields& fields);
 
   bool consistent_damping_ = false;  // Algorithm 2 and the solid takes H^T M_f H
+  double impedance_ratio_ = 0;       // Algorithm 2: gamma_N1 / (m_s / |Gamma| / dt); 0 = unknown
   double robin_auto_value_ = 0;      // coupling.robin_auto's (m_s / |Gamma|) / dt
   SolidModel& solid_;
   FluidModel& fluid_;
