@@ -157,7 +157,20 @@ Scene Scene::parse(const std::string& text, const std::string& origin, const std
   try {
     scene.state_->root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(mark_string(origin, e.mark) + ": not valid YAML: " + e.msg);
+    // YAML forbids tabs in indentation; yaml-cpp then reports the structure it lost ("end of
+    // map not found"), not the tab: name the first line indented with one.
+    std::string hint;
+    std::istringstream lines(text);
+    int number = 0;
+    for (std::string line; std::getline(lines, line);) {
+      ++number;
+      const auto content = line.find_first_not_of(" \t");
+      if (content != std::string::npos && line.find('\t') < content) {
+        hint = fmt::format(" (line {} is indented with a tab: YAML takes spaces only)", number);
+        break;
+      }
+    }
+    throw ConfigError(mark_string(origin, e.mark) + ": not valid YAML: " + e.msg + hint);
   }
   if (!scene.state_->root || scene.state_->root.IsNull()) scene.state_->root = YAML::Node(YAML::NodeType::Map);
   if (!scene.state_->root.IsMap()) throw ConfigError(origin + ": a scene must be a YAML map of sections");

@@ -47,6 +47,16 @@ TEST(Config, UnknownKeyNamesKeyAndLine) {
   EXPECT_NE(msg.find("t.yaml:5"), std::string::npos) << msg;
 }
 
+TEST(Config, ATabInTheIndentationIsNamedWithItsLine) {
+  const std::string text = "solid:\n  model: sdof\n\tmass: 1\n";
+  const auto msg = error_of([&] { (void)fsi::Scene::parse(text, "tab.yaml"); });
+  EXPECT_NE(msg.find("not valid YAML"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("line 3 is indented with a tab"), std::string::npos) << msg;
+  // Without a tab, no such hint.
+  const auto other = error_of([&] { (void)fsi::Scene::parse("solid: [1, 2\n", "bracket.yaml"); });
+  EXPECT_EQ(other.find("tab"), std::string::npos) << other;
+}
+
 TEST(Config, WrongTypeNamesKeyTypeAndLine) {
   auto scene = fsi::Scene::parse("solid:\n  mass: heavy\n", "t.yaml");
   const auto msg = error_of([&] { scene.section("solid").get<double>("mass"); });
