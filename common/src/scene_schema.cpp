@@ -451,9 +451,14 @@ class Checker {
         if (!strings(v) || (k.size && v.size() != static_cast<std::size_t>(k.size))) return type_error(k, v, key, at);
         return;
       case Type::IntList: {
-        bool ok = v.IsSequence() && (!k.size || v.size() == static_cast<std::size_t>(k.size));
-        for (std::size_t i = 0; ok && i < v.size(); ++i) ok = is_integer(v[i]);
-        if (!ok) return type_error(k, v, key, at);
+        if (!v.IsSequence() || (k.size && v.size() != static_cast<std::size_t>(k.size))) return type_error(k, v, key, at);
+        for (std::size_t i = 0; i < v.size(); ++i) {
+          if (!is_integer(v[i]))
+            return add(at, key,
+                       fmt::format("'{}' must be a list of integers: entry {} is {}", key, i + 1,
+                                   v[i].IsScalar() ? "'" + v[i].Scalar() + "'" : scalar_text(v[i])));
+          check_range(k, v[i].as<double>(), v[i], fmt::format("{}[{}]", key, i), at);  // the key's range, per entry
+        }
         return;
       }
       case Type::PointPair:

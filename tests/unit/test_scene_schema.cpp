@@ -1,6 +1,8 @@
 // The scene schema: suggestions, problems with their places, the servers' pre-check.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "fsi/common/scene_reader.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
@@ -65,6 +67,24 @@ TEST(SceneSchema, ProblemsNameKeyPlaceAndSuggestion) {
   EXPECT_EQ(problems("time: {dt: 0.1, end: 1.0}\nsolid: {model: sdof, mass: 1}\nfluid: {model: surrogate}\n"),
             (std::vector<std::string>{"s.yaml: a scene without 'coupling' must have exactly one of 'solid' or "
                                       "'fluid'"}));
+}
+
+TEST(SceneSchema, IntegerListsNameTheBadEntryAndKeepTheirRange) {
+  auto bad = [](const std::string& set) {
+    std::vector<std::string> out;
+    const auto scene = fsi::Scene::load(std::filesystem::path(FSI_SOURCE_DIR) / "configs/fsi1_p2p1.yaml", {set});
+    for (const auto& p : fsi::schema::check_scene(scene).problems) out.push_back(p.text());
+    return out;
+  };
+  const auto fractional = bad("fluid.remesh.at_steps=[3, 1.5]");
+  ASSERT_EQ(fractional.size(), 1u);
+  EXPECT_NE(fractional[0].find("'fluid.remesh.at_steps' must be a list of integers: entry 2 is '1.5'"),
+            std::string::npos)
+      << fractional[0];
+  const auto negative = bad("fluid.remesh.at_steps=[-1]");
+  ASSERT_EQ(negative.size(), 1u);
+  EXPECT_NE(negative[0].find("'fluid.remesh.at_steps[0]' must be >= 1, got '-1'"), std::string::npos) << negative[0];
+  EXPECT_TRUE(bad("fluid.remesh.at_steps=[2, 5]").empty());
 }
 
 TEST(SceneSchema, ServersValidateTheirSectionBeforeBuilding) {

@@ -108,7 +108,7 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                   number("min_curved_jacobian", "P2: minimum relative curved Jacobian that triggers a remesh")
                       .def("0.3")
                       .only_when(element, {"p2p1"}, "p1p1"),
-                  int_list("at_steps", 0, "remesh after these steps in any case (tests)"),
+                  int_list("at_steps", 0, "remesh after these steps in any case (tests)").ge(1),
               }),
       section_list(
           "inflow", "velocity inlets",
