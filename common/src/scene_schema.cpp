@@ -451,7 +451,8 @@ class Checker {
         if (!strings(v) || (k.size && v.size() != static_cast<std::size_t>(k.size))) return type_error(k, v, key, at);
         return;
       case Type::IntList: {
-        if (!v.IsSequence() || (k.size && v.size() != static_cast<std::size_t>(k.size))) return type_error(k, v, key, at);
+        if (!v.IsSequence() || (k.size && v.size() != static_cast<std::size_t>(k.size)))
+          return type_error(k, v, key, at);
         for (std::size_t i = 0; i < v.size(); ++i) {
           if (!is_integer(v[i]))
             return add(at, key,
