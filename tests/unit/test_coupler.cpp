@@ -314,8 +314,8 @@ void expect_monolithic_added_mass(const std::vector<double>& dx, const std::stri
 
 // Algorithm 2 far above the solid's interface impedance Z_s = m / |Gamma| / dt = 100: with
 // gamma_N1 = 1e5 (1000 Z_s) the iterations barely contract, and 1e-10 is out of reach of the
-// 300 allowed. The run ends as stalled once the 20-iteration window shows it, naming the rate
-// and the ratio, not after 300 iterations as "not reached"; at gamma_N1 = 10 Z_s it converges.
+// 300 allowed. The unconverged step is reported as a stall with its rate and the ratio (not
+// only "not reached"); at gamma_N1 = 10 Z_s it converges.
 TEST(AddedMass, AStalledIterationEndsNamedWithTheImpedanceRatio) {
   const std::vector<std::string> common = {"coupling.algorithm=2",
                                            "coupling.relaxation=1",
@@ -334,10 +334,10 @@ TEST(AddedMass, AStalledIterationEndsNamedWithTheImpedanceRatio) {
   EXPECT_EQ(stalled.outcome.status, "diverged");
   EXPECT_EQ(stalled.outcome.steps, 0);
   const std::string& why = stalled.outcome.reason;
-  EXPECT_NE(why.find("coupling stalled at step 1 iteration"), std::string::npos) << why;
+  EXPECT_NE(why.find("coupling tolerance not reached in 300 iterations at step 1"), std::string::npos) << why;
+  EXPECT_NE(why.find("coupling stalled: the residual fell from"), std::string::npos) << why;
   EXPECT_NE(why.find("gamma_N1 is 1e+03 times the solid's interface impedance"), std::string::npos) << why;
-  EXPECT_GT(stalled.iteration_rows.size(), 20u);
-  EXPECT_LT(stalled.iteration_rows.size(), 100u);  // not the 300 of coupling.iterations.max
+  EXPECT_EQ(stalled.iteration_rows.size(), 300u);
   auto fine_set = common;
   fine_set.push_back("coupling.gamma_n1=1000");
   EXPECT_EQ(run_scene(fine_set).outcome.status, "completed");

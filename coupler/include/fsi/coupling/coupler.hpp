@@ -108,7 +108,7 @@ class Coupler {
   // summary.json's "interface" and "coupling", and the set-up's log lines and warnings.
   void describe_setup(nlohmann::json& data, const TimeSettings& time, const InterfaceMeshData& fluid_interface);
   void check_gap(nlohmann::json& data, const InterfaceMeshData& fluid_interface) const;
-  void check_stall(Step& step, double residual) const;
+  std::string stall_note(const Step& step) const;  // check_unconverged's rate and impedance note
   // 2. The state the first step starts from: a checkpoint (resume, fork) or the initial one.
   void start_state(Run& r);
   void find_restart(Run& r);  // --resume's checkpoint, forked_from.json
