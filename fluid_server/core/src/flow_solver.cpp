@@ -16,7 +16,7 @@
 #include "flow_element.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/field_transfer.hpp"
-#include "fsi/fluid/sparse_lu.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -176,7 +176,7 @@ struct BasicFlowSolver<Dim>::Impl {
   std::vector<int> scatter;                    // per triangle local x local positions in valuePtr (column-major local)
   Eigen::SparseMatrix<double> matrix, volume;  // the system (constraints applied); the volume terms (reactions)
   Eigen::VectorXd rhs, rhs_volume;
-  std::unique_ptr<SparseLu> lu;
+  std::unique_ptr<LinearSolver> lu;
   std::vector<DirichletCondition<Dim>> dirichlet;
   std::vector<SymmetryCondition> symmetry;
   std::vector<detail::InterfaceEdge> edges;
@@ -310,7 +310,9 @@ BasicFlowSolver<Dim>::BasicFlowSolver(Mesh mesh, FlowParameters params, const st
   auto& im = *impl_;
   im.element = make_element(element, std::move(mesh));
   im.dof = im.element->layout();
-  im.lu = std::make_unique<SparseLu>(params_);
+  std::vector<char> pressure(static_cast<std::size_t>(im.dof.dofs), 0);
+  for (int v = 0; v < im.mesh().vertices(); ++v) pressure[static_cast<std::size_t>(im.dof.pressure(v))] = 1;
+  im.lu = make_linear_solver(params_, Dim, std::move(pressure));
   im.build_pattern();
   U_ = U_n_ = U_nm1_ = reaction_ = Eigen::VectorXd::Zero(im.dof.dofs);
   X_ = X_n_ = X_nm1_ = im.mesh().nodes;

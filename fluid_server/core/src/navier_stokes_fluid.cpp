@@ -14,6 +14,7 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/scene_reader.hpp"
 #include "fsi/fluid/field_transfer.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 #include "fsi/fluid/mesh_quality.hpp"
 #include "fsi/fluid/remesh.hpp"
 
@@ -157,7 +158,29 @@ void read_linear_solver(const schema::Reader& section, bool taylor_hood, FlowPar
   params.umfpack_irstep = section.get<int>("umfpack_irstep");
   if (taylor_hood) params.strategy = LuStrategy::Symmetric;
   const auto ls = section.optional_child("linear_solver");
-  if (!ls) return;
+  const int ranks = section.get<int>("ranks");
+  (void)section.declared("mpi");  // read by the launcher (fsi run)
+  if (ranks != mpi_world_size())
+    section.fail("ranks", fmt::format("is {} but this fluid_server runs on {} MPI rank(s): fsi run starts it under "
+                                      "mpirun -n {} (or start it so yourself)",
+                                      ranks, mpi_world_size(), ranks));
+  if (!ls) {
+    if (ranks > 1) section.fail("ranks", "needs fluid.linear_solver.engine: petsc or mumps (UMFPACK runs on one rank)");
+    return;
+  }
+  const auto engine = ls->get<std::string>("engine");
+  params.engine = engine == "petsc"   ? LinearEngine::Petsc
+                  : engine == "mumps" ? LinearEngine::Mumps
+                                      : LinearEngine::Umfpack;
+  if (ranks > 1 && params.engine == LinearEngine::Umfpack)
+    section.fail("ranks", "needs fluid.linear_solver.engine: petsc or mumps (UMFPACK runs on one rank)");
+  if (params.engine != LinearEngine::Umfpack && !petsc_available())
+    ls->fail("engine", "this build has no PETSc (install libpetsc-real-dev, scripts/install-deps.sh, and reconfigure)");
+  params.petsc_options = ls->get<std::string>("petsc_options");
+  if (params.engine == LinearEngine::Umfpack && !params.petsc_options.empty())
+    ls->fail("petsc_options", "is for the petsc and mumps engines (engine is umfpack)");
+  params.petsc_reuse_preconditioner = ls->get<bool>("petsc_reuse_preconditioner");
+  params.petsc_rebuild_factor = ls->get<double>("petsc_rebuild_factor");
   const auto ordering = ls->get<std::string>("ordering");
   params.ordering = ordering == "metis" ? Ordering::Metis : ordering == "amd" ? Ordering::Amd : Ordering::Auto;
   const auto strategy = ls->get_or<std::string>("strategy", taylor_hood ? "symmetric" : "auto");

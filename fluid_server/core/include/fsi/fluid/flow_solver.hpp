@@ -84,6 +84,9 @@ enum class Ordering { Amd, Metis, Auto };
 // elements' saddle-point matrices (measured: 20 % faster factorisations, 30 % faster solves
 // than Auto on Taylor-Hood); Auto lets UMFPACK decide from the pattern.
 enum class LuStrategy { Auto, Symmetric, Unsymmetric };
+// The linear-algebra engine (linear_solver.hpp): UMFPACK (sparse_lu.hpp), a PETSc Krylov solver
+// (field-split preconditioner by default), or MUMPS through PETSc.
+enum class LinearEngine { Umfpack, Petsc, Mumps };
 
 struct FlowParameters {
   double density = 1.0;
@@ -122,6 +125,14 @@ struct FlowParameters {
   // current factors (their factorisation included): minimises the cost per step. Costs are
   // counted in flops, not measured, so the decisions are reproducible (sparse_lu.hpp).
   bool adaptive_refactorisation = true;
+  LinearEngine engine = LinearEngine::Umfpack;
+  // PETSc engines: options after the engine's defaults (default_petsc_options), e.g.
+  // "-ksp_rtol 1e-12 -fieldsplit_p_pc_type gamg"; an option the solver leaves unused is an error.
+  std::string petsc_options;
+  // PETSc engines: keep the preconditioner of an earlier matrix while the iterations stay below
+  // petsc_rebuild_factor x those of its first solve (+ 5) (and it converges); else rebuild.
+  bool petsc_reuse_preconditioner = true;
+  double petsc_rebuild_factor = 1.5;
 };
 
 struct StepReport {
