@@ -469,6 +469,7 @@ std::map<std::string, double> NavierStokesFluid::probes3() {
   probes["nonlinear_iterations"] = last_report_.iterations;
   probes["nonlinear_change"] = last_report_.change;
   probes["factorisations"] = factorisations_;
+  probes["linear_iterations"] = linear_iterations_;  // Krylov iterations so far (3D only: 2D outputs unchanged)
   return probes;
 }
 
@@ -868,6 +869,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
     solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++solves_;
     factorisations_ += last_report_.factorisations;
+    linear_iterations_ += last_report_.krylov_iterations;
     assembly_seconds_ += last_report_.assembly_seconds;
     factor_seconds_ += last_report_.factor_seconds;
     linear_solve_seconds_ += last_report_.solve_seconds;

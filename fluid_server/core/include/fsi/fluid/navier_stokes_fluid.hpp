@@ -150,6 +150,7 @@ class NavierStokesFluid : public FluidModel {
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
   int factorisations_ = 0;                           // cumulative
+  int linear_iterations_ = 0;                        // cumulative Krylov iterations (3D probe)
   Eigen::VectorXd last_interface_displacement_;      // of the last solve (for the mesh motion's accept)
   Eigen::VectorXd accepted_interface_displacement_;  // of the last accepted step (a remesh's new offset)
   int retried_step_ = -1;                            // the step whose folding motion was remeshed and solved again
