@@ -25,7 +25,7 @@ VARIANTS = {
     "umfpack": ([], 1),
     "mumps": (["fluid.linear_solver.engine=mumps"], 1),
     "petsc": ([ITERATIVE], 1),
-    "petsc_noreuse": ([ITERATIVE, "fluid.linear_solver.petsc_reuse_preconditioner=false"], 1),
+    "petsc_reuse": ([ITERATIVE, "fluid.linear_solver.petsc_reuse_preconditioner=true"], 1),
     "petsc_2ranks": ([ITERATIVE, "fluid.ranks=2"], 2),
     "mumps_2ranks": (["fluid.linear_solver.engine=mumps", "fluid.ranks=2"], 2),
     # Preconditioner study (fresh preconditioner every Newton iteration, so the counts compare).

@@ -14,6 +14,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -105,6 +106,7 @@ struct Header {
   int reuse = 0;
   int has_guess = 0;
   int check_options = 0;
+  int max_it = 0;  // > 0: the iteration limit of a solve with a kept preconditioner
 };
 
 }  // namespace
@@ -132,6 +134,7 @@ class PetscSystem {
     std::string error;  // "" = solved (or rank != 0 after an error: the same error everywhere)
     bool converged = true;
     int iterations = 0;
+    int fresh_iterations = 0;  // of the solve with a fresh preconditioner (if it was rebuilt)
     int reason = 0;
     bool rebuilt = false;
     double setup_seconds = 0, solve_seconds = 0;
@@ -154,9 +157,16 @@ class PetscSystem {
       FSI_PETSC(KSPSetUp(ksp_));
       out.rebuilt = !h.reuse;
       out.setup_seconds = seconds_since(t_setup);
+      PetscReal rtol = 0, abstol = 0, dtol = 0;
+      PetscInt max_it = 0;
+      FSI_PETSC(KSPGetTolerances(ksp_, &rtol, &abstol, &dtol, &max_it));
+      const bool capped = h.reuse && h.max_it > 0 && h.max_it < max_it;
+      if (capped) FSI_PETSC(KSPSetTolerances(ksp_, rtol, abstol, dtol, h.max_it));
       run(out);
+      if (capped) FSI_PETSC(KSPSetTolerances(ksp_, rtol, abstol, dtol, max_it));
       if (!out.converged && h.reuse) {
-        // The kept preconditioner failed: a fresh one (decided alike on every rank).
+        // The kept preconditioner failed (or needed more than the cap): a fresh one, decided
+        // alike on every rank from the converged reason they share.
         const auto t_rebuild = Clock::now();
         FSI_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));
         FSI_PETSC(KSPSetOperators(ksp_, A_, A_));
@@ -165,7 +175,10 @@ class PetscSystem {
         out.rebuilt = true;
         const int before = out.iterations;
         run(out);
+        out.fresh_iterations = out.iterations;
         out.iterations += before;
+      } else if (out.rebuilt) {
+        out.fresh_iterations = out.iterations;
       }
       if (h.check_options) out.unused = unused_options();
       KSPType kt = nullptr;
@@ -528,6 +541,8 @@ Eigen::VectorXd PetscSolver::solve(const Eigen::SparseMatrix<double>& A, const E
   h.check_options = !s.options_checked;
   if (h.new_pattern || time_coefficient != s.time_coefficient) s.have_pc = false;
   h.reuse = s.params.petsc_reuse_preconditioner && s.have_pc && !s.system->preonly();
+  // A kept preconditioner gets as many iterations as the rebuild rule allows; beyond, a fresh one.
+  if (h.reuse) h.max_it = static_cast<int>(std::ceil(s.params.petsc_rebuild_factor * s.pc_iterations)) + 5;
   const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = A;
   Eigen::VectorXd x;
   send_command(kSolve, s.id);
@@ -563,7 +578,7 @@ Eigen::VectorXd PetscSolver::solve(const Eigen::SparseMatrix<double>& A, const E
   report.solve_seconds += outcome.solve_seconds;
   if (outcome.rebuilt) {
     ++report.factorisations;
-    s.pc_iterations = outcome.iterations;
+    s.pc_iterations = outcome.fresh_iterations;
     s.have_pc = true;
   }
   if (!outcome.converged)
