@@ -69,7 +69,8 @@ def run(name, sets, ranks, level, out_root, wrap, extra):
     m = re.search(r"Maximum resident set size \(kbytes\): (\d+)", text)
     row["rss_mb"] = int(m.group(1)) / 1024 if m else float("nan")
     if p.returncode != 0:
-        row["error"] = text[-600:]
+        errors = [l for l in text.splitlines() if "[error]" in l or "did not converge" in l]
+        row["error"] = " / ".join(errors)[-600:] or text[-600:]
         return row
     with open(os.path.join(out, "probes.csv")) as f:
         last = list(csv.DictReader(f))[-1]

@@ -87,8 +87,9 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                        "option the solver does not use is refused")
                       .def("\"\""),
                   boolean("petsc_reuse_preconditioner",
-                          "petsc: keep the preconditioner of an earlier matrix while it works")
-                      .def("true"),
+                          "petsc: keep the preconditioner of an earlier matrix while it works (a kept one that "
+                          "needs more iterations than petsc_rebuild_factor allows is replaced within the solve)")
+                      .def_computed("false when steady (Newton iterations), true with BDF time steps"),
                   number("petsc_rebuild_factor",
                          "petsc: rebuild once a solve needs more than this times the iterations of the "
                          "preconditioner's first solve (+ 5)")
