@@ -80,7 +80,7 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                          "umfpack: UMFPACK LU (the settings below); petsc: PETSc GMRES with a field-split Schur "
                          "preconditioner (ILU(0) velocity, BoomerAMG on the selfp Schur complement); mumps: the "
                          "MUMPS direct solver through PETSc")
-                      .def_computed("umfpack"),
+                      .def_computed("umfpack in 2D; petsc in 3D (umfpack in a build without PETSc)"),
                   text("petsc_options",
                        "petsc / mumps: further PETSc options after the engine's defaults, e.g. \"-ksp_rtol 1e-12\" "
                        "(the KSP's and its PC's options, sub-solvers as -fieldsplit_u_* / -fieldsplit_p_*); an "
