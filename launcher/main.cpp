@@ -37,6 +37,7 @@
 #include "fsi/common/config.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
+#include "fsi/common/scene_reader.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/version.hpp"
@@ -267,16 +268,20 @@ std::string find_program(const std::string& name) {
 // (fluid.mpi: command, hostfile, args); empty for one rank (no MPI launcher at all).
 std::vector<std::string> fluid_mpi_launcher(const fsi::Scene& scene) {
   if (!scene.has("fluid.ranks")) return {};
-  const auto fluid = scene.section("fluid");
+  // fluid.ranks and fluid.mpi are keys of the fem fluid (navier_stokes_keys.cpp).
+  const auto& variants = fsi::models::fluid_section().variants;
+  const auto fem = std::find_if(variants.begin(), variants.end(), [](const auto& v) { return v.value == "fem"; });
+  if (fem == variants.end()) return {};
+  const fsi::ConfigSection section = scene.section("fluid");
+  const fsi::schema::Reader fluid(section, fem->keys);
   const int ranks = fluid.get<int>("ranks");
   if (ranks <= 1) return {};
-  std::string command = "mpirun", hostfile;
-  std::vector<std::string> args;
-  if (const auto mpi = fluid.optional_child("mpi")) {
-    command = mpi->get<std::string>("command", "mpirun");
-    if (mpi->has("hostfile")) hostfile = mpi->get_path("hostfile").string();
-    args = mpi->get<std::vector<std::string>>("args", {});
-  }
+  const auto mpi_key =
+      std::find_if(fem->keys.begin(), fem->keys.end(), [](const fsi::schema::Key& k) { return k.name == "mpi"; });
+  const fsi::schema::Reader mpi(section.child_or_empty("mpi"), mpi_key->children);
+  const auto command = mpi.get<std::string>("command");
+  const std::string hostfile = mpi.has("hostfile") ? mpi.path("hostfile").string() : "";
+  const auto args = mpi.get<std::vector<std::string>>("args");
   const std::string program = find_program(command);
   if (program.empty())
     throw fsi::ConfigError(fmt::format(
