@@ -1,8 +1,9 @@
 #pragma once
 // The fluid solver: Navier-Stokes in ALE form on a (moving) triangle mesh, with strong
 // Dirichlet and symmetry conditions, do-nothing outlets, a Nitsche interface, BDF1/BDF2,
-// Picard or Newton iterations, UMFPACK (sparse_lu.hpp) and consistent reaction forces. One
-// time-stepping, assembly, interface and checkpoint path for both elements:
+// Picard or Newton iterations, a linear-algebra engine (linear_solver.hpp: UMFPACK, PETSc,
+// MUMPS) and consistent reaction forces. One time-stepping, assembly, interface and checkpoint
+// path for both elements:
 //   "p1p1" - equal-order P1/P1 with SUPG/PSPG/LSIC (the seed paper's element; NavierStokesSolver)
 //   "p2p1" - isoparametric Taylor-Hood P2/P1 (inf-sup stable; optional SUPG, grad-div; TaylorHoodSolver)
 // whose element parts (local assembly, DOF layout, interface traces, output) sit behind one
