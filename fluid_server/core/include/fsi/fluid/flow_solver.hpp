@@ -122,6 +122,9 @@ struct FlowParameters {
   // current factors (their factorisation included): minimises the cost per step. Costs are
   // counted in flops, not measured, so the decisions are reproducible (sparse_lu.hpp).
   bool adaptive_refactorisation = true;
+  // Tests only (the GCL tests' control): the ALE mesh velocity is multiplied by this; anything
+  // but 1 is a wrong mesh velocity, which a GCL test must detect.
+  double mesh_velocity_scale = 1.0;
 };
 
 struct StepReport {
