@@ -1,7 +1,8 @@
 """Reads a 3D fluid .vtu with meshio (test_tet_motion.cpp, Vtk3): prints the number of points,
 of quadratic tetrahedra, the velocity's largest deviation from u = (x, 2 y, -3 z) at the points,
 the pressure's length, how many midpoints are not at the middle of their VTK edge (01 12 20 03
-13 23) and how many tetrahedra have a negative volume."""
+13 23) and how many tetrahedra have a negative volume; with VTK's own reader (python3-vtk9, what
+ParaView uses) if installed, the number of cells and their type."""
 import sys
 
 import meshio
@@ -30,3 +31,16 @@ print("midpoints_off_their_edge", off)
 vol = np.einsum("ij,ij->i", x[cells[:, 1]] - x[cells[:, 0]],
                 np.cross(x[cells[:, 2]] - x[cells[:, 0]], x[cells[:, 3]] - x[cells[:, 0]]))
 print("negative_volumes", int((vol <= 0).sum()))
+# VTK itself (what ParaView reads with), when installed: cells and their type (24 = quadratic tetra).
+try:
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+except ImportError:
+    vtkXMLUnstructuredGridReader = None
+if vtkXMLUnstructuredGridReader is not None:
+    reader = vtkXMLUnstructuredGridReader()
+    reader.SetFileName(sys.argv[1])
+    reader.Update()
+    grid = reader.GetOutput()
+    types = {grid.GetCellType(i) for i in range(grid.GetNumberOfCells())}
+    print("vtk_cells", grid.GetNumberOfCells())
+    print("vtk_cell_type", types.pop() if len(types) == 1 else -1)
