@@ -352,7 +352,7 @@ TEST(Vtk3, QuadraticTetrahedraAreReadBackWithTheirValues) {
   p.scheme = TimeScheme::BDF1;
   FlowSolver3 s(TetMesh::box({0, 0, 0}, {1, 0.5, 0.5}, 2, 2, 2), p, "p2p1");
   const auto& mesh = s.mesh();
-  // A known velocity (u = (x, 2 y, -3 z)) and a moved mesh (x -> x + 0.1 y).
+  // A known velocity: u = (x, 2 y, -3 z).
   Eigen::MatrixX3d u(mesh.node_count(), 3);
   for (int i = 0; i < mesh.node_count(); ++i) u.row(i) << mesh.nodes(i, 0), 2 * mesh.nodes(i, 1), -3 * mesh.nodes(i, 2);
   s.set_initial_velocity(u);
