@@ -96,6 +96,12 @@ struct GclCase {
   bool linear_flow;
 };
 
+std::string name(const GclCase& c) {
+  return std::string(c.scheme == TimeScheme::BDF1 ? "BDF1" : "BDF2") +
+         (c.motion == Motion::Shear ? "Shear" : "Translation") + (c.linear_flow ? "LinearFlow" : "UniformFlow");
+}
+void PrintTo(const GclCase& c, std::ostream* os) { *os << name(c); }  // ctest names without padding bytes
+
 class Gcl3 : public ::testing::TestWithParam<GclCase> {};
 
 TEST_P(Gcl3, FlowIsReproducedToRoundOffOnTheMovingMesh) {
@@ -114,7 +120,8 @@ INSTANTIATE_TEST_SUITE_P(Cases, Gcl3,
                                            GclCase{TimeScheme::BDF1, Motion::Shear, false},
                                            GclCase{TimeScheme::BDF2, Motion::Shear, false},
                                            GclCase{TimeScheme::BDF1, Motion::Shear, true},
-                                           GclCase{TimeScheme::BDF2, Motion::Shear, true}));
+                                           GclCase{TimeScheme::BDF2, Motion::Shear, true}),
+                         [](const ::testing::TestParamInfo<GclCase>& info) { return name(info.param); });
 
 TEST(Gcl3Control, AWrongMeshVelocityFails) {
   // The same checks with the mesh velocity off (scale 0) and half its value: the linear flow
