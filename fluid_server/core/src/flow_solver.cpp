@@ -437,6 +437,7 @@ typename BasicFlowSolver<Dim>::Step BasicFlowSolver<Dim>::begin_step(double time
   s.alpha0_dt = steady ? 0.0 : alpha0 / dt;
   s.mesh_velocity = Nodes::Zero(n, Dim);
   if (!steady) s.mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
+  if (params_.mesh_velocity_scale != 1.0) s.mesh_velocity *= params_.mesh_velocity_scale;
   s.U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
   // A later coupling iteration of the step starts its linear solve from the last iterate's
   // solution (closer than the extrapolation; the system solved is the same).

@@ -15,6 +15,7 @@
 #include "fsi/common/scene_reader.hpp"
 #include "fsi/fluid/field_transfer.hpp"
 #include "fsi/fluid/linear_solver.hpp"
+#include "fsi/fluid/flow_vtk.hpp"
 #include "fsi/fluid/mesh_quality.hpp"
 #include "fsi/fluid/remesh.hpp"
 
@@ -455,6 +456,7 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
   fsi::logger("fluid")->info(
       "fluid: 3D p2p1 (Taylor-Hood), {} nodes, {} tetrahedra, {} unknowns, scheme {}, {}, mesh {}", m.node_count(),
       m.cell_count(), solver3_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard", msh.string());
+  configure_vtk(section);
   start_ = last_log_ = std::chrono::steady_clock::now();
 }
 
@@ -612,8 +614,12 @@ void NavierStokesFluid::configure_output(const schema::Reader& section, double d
           pd->fail(k, "unknown pressure probe '" + p + "'");
       pressure_differences_.push_back({k, {pair[0], pair[1]}});
     }
-  // VTK whenever the run asks (time.output_every), unless output.vtk_every says otherwise:
-  // N > 0 = only at steps that are multiples of N, 0 = never.
+  configure_vtk(section);
+}
+
+// VTK whenever the run asks (time.output_every), unless output.vtk_every says otherwise:
+// N > 0 = only at steps that are multiples of N, 0 = never. Both dimensions (flow_vtk.hpp).
+void NavierStokesFluid::configure_vtk(const schema::Reader& section) {
   if (auto out = section.optional_child("output")) {
     vtk_every_ = out->get_or<int>("vtk_every", -1);
   }
@@ -1036,18 +1042,8 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
 }
 
 std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {
-  if (solver3_) return {};  // no VTK tetrahedra yet
   if (vtk_every_ == 0 || setup_.output_dir.empty() || (vtk_every_ > 0 && info.step % vtk_every_ != 0)) return {};
-  const auto mesh = solver_->mesh().linear_refinement();  // P2: 4 linear triangles per element
-  VtkGrid grid;
-  grid.points = solver_->positions();
-  for (int e = 0; e < mesh.triangle_count(); ++e) {
-    grid.cells.push_back({mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)});
-    grid.cell_types.push_back(VtkCellType::Triangle);
-  }
-  grid.point_data["velocity"] = solver_->velocity();
-  grid.point_data["pressure"] = solver_->pressure();
-  grid.point_data["mesh_displacement"] = solver_->positions() - mesh.nodes;
+  const VtkGrid grid = solver3_ ? flow_vtk_grid(*solver3_) : flow_vtk_grid(*solver_);
   return {vtk_.write(info.time, info.step, grid).string()};
 }
 

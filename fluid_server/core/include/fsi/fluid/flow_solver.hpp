@@ -134,6 +134,9 @@ struct FlowParameters {
   // petsc_rebuild_factor x those of its first solve (+ 5) (and it converges); else rebuild.
   bool petsc_reuse_preconditioner = true;
   double petsc_rebuild_factor = 1.5;
+  // Tests only (the GCL tests' control): the ALE mesh velocity is multiplied by this; anything
+  // but 1 is a wrong mesh velocity, which a GCL test must detect.
+  double mesh_velocity_scale = 1.0;
 };
 
 struct StepReport {

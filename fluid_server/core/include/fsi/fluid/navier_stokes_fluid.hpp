@@ -111,6 +111,7 @@ class NavierStokesFluid : public FluidModel {
   void configure_mesh_motion(const schema::Reader& section, const std::vector<std::string>& groups,
                              const std::vector<std::string>& fixed_groups);
   void configure_output(const schema::Reader& section, double density);
+  void configure_vtk(const schema::Reader& section);  // fluid.output.vtk_every (both dimensions)
   void build_mesh_motion();
   // Remeshing (fluid.remesh; remesh.hpp).
   struct RemeshSettings {
