@@ -14,8 +14,8 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/scene_reader.hpp"
 #include "fsi/fluid/field_transfer.hpp"
-#include "fsi/fluid/linear_solver.hpp"
 #include "fsi/fluid/flow_vtk.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 #include "fsi/fluid/mesh_quality.hpp"
 #include "fsi/fluid/remesh.hpp"
 
