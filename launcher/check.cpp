@@ -30,9 +30,11 @@ bool is_study_file(const std::string& file) {
 namespace {
 // One scene check with overrides (`placed`: with the place they were written), as JSON.
 nlohmann::json check_json(const std::string& file, const std::vector<std::string>& overrides,
-                          const std::vector<std::pair<std::string, std::string>>& placed) {
+                          const std::vector<std::pair<std::string, std::string>>& placed,
+                          const std::vector<std::string>& skip_sections = {}) {
   std::vector<std::string> all = overrides;
   schema::CheckOptions options;
+  options.skip_sections = skip_sections;
   for (const auto& [assignment, where] : placed) {
     all.push_back(assignment);
     options.override_origins.push_back({assignment, where});
@@ -51,8 +53,9 @@ nlohmann::json check_json(const std::string& file, const std::vector<std::string
 }  // namespace
 
 int check_file(const std::string& file, const std::vector<std::string>& overrides,
-               const std::vector<std::pair<std::string, std::string>>& placed, bool json) {
-  const nlohmann::json result = check_json(file, overrides, placed);
+               const std::vector<std::pair<std::string, std::string>>& placed, bool json,
+               const std::vector<std::string>& skip_sections) {
+  const nlohmann::json result = check_json(file, overrides, placed, skip_sections);
   if (json) {
     std::cout << result.dump() << "\n";
     return result["problems"].empty() ? 0 : 1;
@@ -61,7 +64,10 @@ int check_file(const std::string& file, const std::vector<std::string>& override
     for (const auto& p : result["problems"]) std::cerr << p["text"].get<std::string>() << "\n";
     return 1;
   }
-  std::cout << fmt::format("OK: {} ({} keys checked)\n", file, result["keys_checked"].get<int>());
+  std::string skipped;
+  for (const auto& section : skip_sections) skipped += (skipped.empty() ? "" : ", ") + section;
+  std::cout << fmt::format("OK: {} ({} keys checked{})\n", file, result["keys_checked"].get<int>(),
+                           skipped.empty() ? "" : "; " + skipped + " left to the external solver");
   return 0;
 }
 

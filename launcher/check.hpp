@@ -13,9 +13,11 @@ namespace fsi::launcher {
 // ("key=value") with the place they were written ("file:line:col"), named in the problems (the
 // study tool checks a study's cases this way). `json`: one JSON object on stdout instead
 // ({"file", "keys_checked", "problems": [{"where", "message", "key", "text"}]}). A study is
-// read by the study tool (fsi_study.py check), not here.
+// read by the study tool (fsi_study.py check), not here. `skip_sections`: sections an external
+// solver reads (`fsi check --solid-command ...`, as `fsi run` skips them).
 int check_file(const std::string& file, const std::vector<std::string>& overrides,
-               const std::vector<std::pair<std::string, std::string>>& placed = {}, bool json = false);
+               const std::vector<std::pair<std::string, std::string>>& placed = {}, bool json = false,
+               const std::vector<std::string>& skip_sections = {});
 
 // Many checks of one scene in one process (the study tool's cases): `cases` is a JSON list of
 // cases, each a list of [assignment, where] on top of `overrides` and `placed`; prints one JSON

@@ -862,6 +862,7 @@ struct CheckOptions {
   bool reference = false;
   bool json = false;
   bool cases = false;
+  std::string solid_command, fluid_command;  // external solvers: their sections are not checked
 };
 
 CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
@@ -878,6 +879,11 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& c) {
   check_cmd->add_flag("--cases", c.cases,
                       "read a JSON list of cases from stdin, each a list of [key=value, file:line:col] on top of "
                       "the other overrides, and print a JSON list of their results (the study tool)");
+  check_cmd->add_option("--solid-command", c.solid_command,
+                        "the scene runs with this external solid (as fsi run --solid-command): its solid section is "
+                        "the external solid's, not checked here");
+  check_cmd->add_option("--fluid-command", c.fluid_command,
+                        "the scene runs with this external fluid: its fluid section is not checked here");
   check_cmd->add_flag("--reference", c.reference,
                       "print the scene reference (Markdown, docs/scene-reference.md) from the schema");
   return check_cmd;
@@ -898,7 +904,10 @@ int check(const CheckOptions& c) {
     return study_tool("check", args);
   }
   if (c.cases) return fsi::launcher::check_cases(c.file, c.overrides, c.placed, std::cin);
-  return fsi::launcher::check_file(c.file, c.overrides, c.placed, c.json);
+  std::vector<std::string> external;
+  if (!c.solid_command.empty()) external.push_back("solid");
+  if (!c.fluid_command.empty()) external.push_back("fluid");
+  return fsi::launcher::check_file(c.file, c.overrides, c.placed, c.json, external);
 }
 
 // `fsi keys DIR`: the coupler writes the key folder. Replaces this process; returns only on failure.

@@ -162,6 +162,20 @@ def override_typo():
            "OK: configs/sdof_model.yaml (29 keys checked)\n")
 
 
+def external_solver():
+    """A scene whose solid section belongs to an external solid (its own keys): refused by a plain
+    check, accepted with --solid-command (as fsi run --solid-command skips it), the rest still checked."""
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = edited(tmp, "sdof_model.yaml", [("solid:\n", "solid:\n  my_own_key: 3\n")])
+        code, out, err, _ = fsi("check", scene)
+        assert code == 1 and "unknown key 'solid.my_own_key'" in err, (code, out, err)
+        code, out, err, _ = fsi("check", scene, "--solid-command", "python3 my_solid.py")
+        assert code == 0 and err == "" and out.endswith("; solid left to the external solver)\n"), (code, out, err)
+        code, out, err, _ = fsi("check", scene, "--solid-command", "python3 my_solid.py", "--set", "coupling.relaxtion=1")
+        assert code == 1 and "unknown key 'coupling.relaxtion'" in err, (code, out, err)
+    print("an external solid's section is its own; the other sections are still checked")
+
+
 def study():
     """A study: its scene with `fixed` as overrides, every value of `vary` / `zip` and the names of `derived`,
     reported at the study's lines."""
@@ -194,7 +208,7 @@ def reference_current():
 
 
 CASES = {f.__name__: f for f in (shipped, solver_typos, misspelt_required, wrong_type, out_of_range, override_typo,
-                                 study, reference_current)}
+                                 external_solver, study, reference_current)}
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser()
