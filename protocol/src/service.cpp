@@ -44,6 +44,15 @@ Eigen::VectorXd checked_vector(const google::protobuf::RepeatedField<double>& fi
   return to_eigen(field);
 }
 
+// The step of a solve_step request: dt positive and the time finite (a model divides by dt).
+StepInfo checked_step(const fsi::v1::SolveStep& s) {
+  if (!(s.dt() > 0) || !std::isfinite(s.dt()))
+    throw std::invalid_argument(fmt::format("solve_step: dt must be positive, got {}", s.dt()));
+  if (!std::isfinite(s.time()))
+    throw std::invalid_argument(fmt::format("solve_step: time must be finite, got {}", s.time()));
+  return {s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
+}
+
 void require_finite(const Eigen::VectorXd& v, int dim, const std::string& what) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
@@ -238,7 +247,7 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       const auto& s = request.solve_step();
       const Eigen::VectorXd force =
           checked_vector(s.interface_force(), interface_nodes_, dimension_, "interface_force");
-      StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
+      const StepInfo info = checked_step(s);
       if (s.has_interface_mass())
         model_->set_interface_mass(nodal_from_proto(s.interface_mass(), interface_nodes_, "interface_mass"));
       const SolidStepResult result = model_->solve_step(info, force);
@@ -323,7 +332,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     case R::kSolveStep: {
       need_model("solve_step");
       const auto& s = request.solve_step();
-      StepInfo info{s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
+      const StepInfo info = checked_step(s);
       loads_reply(model_->solve_step(
           info, checked_vector(s.interface_displacement(), interface_nodes_, dimension_, "interface_displacement"),
           checked_vector(s.interface_velocity(), interface_nodes_, dimension_, "interface_velocity")));

@@ -550,6 +550,10 @@ class Server:
         if bad.size:
             i = int(bad[0])
             raise InvalidArgument(f"'interface_force' is not finite at node {i // d} ({'xyz'[i % d]}): {force[i]}")
+        if not (math.isfinite(st.dt) and st.dt > 0):
+            raise InvalidArgument(f"solve_step: dt must be positive, got {st.dt}")
+        if not math.isfinite(st.time):
+            raise InvalidArgument(f"solve_step: time must be finite, got {st.time}")
         if self._dirty:
             self._restore()  # a repeated solve_step: start again from the last accepted state
         self._dirty = True

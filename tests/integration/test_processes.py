@@ -153,6 +153,8 @@ def bad_messages(env):
     expect_error(call(request(7, solve_step=wrong)), pb.Error.INVALID_ARGUMENT, "has 3 values, expected 2")
     nan = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[float("nan"), 0.0])
     expect_error(call(request(8, solve_step=nan)), pb.Error.INVALID_ARGUMENT, "not finite")
+    zero_dt = pb.SolveStep(time=0.02, dt=0.0, step=1, iteration=1, interface_force=[1.0, 0.0])
+    expect_error(call(request(8, solve_step=zero_dt)), pb.Error.INVALID_ARGUMENT, "dt must be positive, got 0")
     ok = call(request(9, solve_step=step))
     d = ok.solid_step.interface_displacement[0]
     expected = 1.0 / (1 / 0.02 ** 2 + (2.5 + 10) / 0.02 + 10)

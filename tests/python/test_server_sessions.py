@@ -2,6 +2,7 @@
 """fsi.server's sessions and exit codes, over real sockets, as the C++ servers behave
 (proto/README.md, "Sessions"):
 
+- a solve_step with dt <= 0 or NaN is INVALID_ARGUMENT (not the solid's ZeroDivisionError);
 - a second client during a session gets BUSY naming the session, its client and since when,
   and the run of the first goes on undisturbed;
 - when the session's connection closes (the coupler died) the server forgets its
@@ -148,6 +149,10 @@ with tempfile.TemporaryDirectory() as tmp:
     check(error(r1) is None and error(r2) is None and
           list(r1.solid_step.interface_displacement) == list(r2.solid_step.interface_displacement),
           "the first client's session is undisturbed (a repeated solve gives the same answer)")
+    for dt, what in ((0.0, "dt must be positive, got 0.0"), (float("nan"), "dt must be positive, got nan")):
+        e = error(first.call(solve_step=pb.SolveStep(time=0.1, dt=dt, step=1, iteration=1, interface_force=[1.0, 0.0])))
+        check(e is not None and e[0] == "INVALID_ARGUMENT" and what in e[1],
+              f"solve_step with dt = {dt} is an INVALID_ARGUMENT naming dt, not an INTERNAL error of the solid: {e}")
     r = first.call(stop=pb.Stop(reason="completed"))
     check(error(r) is None and r.HasField("stop"), "stop is answered")
     code, log = finish(p)
