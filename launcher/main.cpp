@@ -51,12 +51,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Launcher limits: a server must write its port file within 60 s of starting and answer the
-// coupler's Hello within 30 s (generous: a loaded machine, a Python solver importing its modules); at the end each
-// process gets 3 s to exit after Stop (1 s when the run failed: a server that never answered got no Stop it could
-// obey), then SIGTERM, then SIGKILL 0.5 s later.
-constexpr std::chrono::seconds kPortFileWait{60};
-constexpr int kHelloWaitSeconds = 30;  // generous: a loaded machine, a Python solver importing its modules
+// Launcher limits: a server must write its port file within --start-timeout (60 s) of starting and answer
+// the coupler's Hello within half of it (generous: a loaded machine, a Python solver importing its modules); at
+// the end each process gets 3 s to exit after Stop (1 s when the run failed: a server that never answered got no
+// Stop it could obey), then SIGTERM, then SIGKILL 0.5 s later.
 
 volatile std::sig_atomic_t g_signal = 0;
 extern "C" void on_signal(int sig) { g_signal = sig; }
@@ -333,6 +331,7 @@ struct RunOptions {
   std::string initial_state;  // --initial-state: the same, for the fluid's fields only
   std::vector<std::string> overrides;
   double timeout = 600;
+  int start_timeout = 60;  // --start-timeout: seconds for a server's port file (its Hello: half of it)
   bool resume = false, force = false;
   bool plot = false;  // --plot: tools/fsi_plot.py on --out at the end
   int recover = -1;   // -1: 3 when checkpoints are on, else 0
@@ -462,7 +461,7 @@ void start_servers(const RunOptions& o, const fs::path& ports, CoupledProcesses&
     Server s{side, command, "", ports / (side + ".port"), fs::path(o.out_dir) / (side + "_server.log"), o.curve_keys};
     if (side == "fluid" && command.empty()) s.mpi = fluid_mpi;
     const std::size_t i = side == "solid" ? 0 : 1;
-    p.children[i] = start_server(s, self_dir(), "tcp://127.0.0.1:*", kPortFileWait);
+    p.children[i] = start_server(s, self_dir(), "tcp://127.0.0.1:*", std::chrono::seconds(o.start_timeout));
     log->info("{} listening on {} (log: {})", p.children[i].name, s.endpoint, s.log.string());
     p.servers.push_back(s);
   }
@@ -482,7 +481,7 @@ std::vector<std::string> coupler_command(const RunOptions& o, const CoupledProce
                                 "--timeout",
                                 fmt::format("{}", o.timeout),
                                 "--connect-timeout",
-                                std::to_string(kHelloWaitSeconds),
+                                std::to_string(std::max(1, o.start_timeout / 2)),
                                 "--out-ready"};
   if (resume) argv.push_back("--resume");
   if (resume && attempts > 0) argv.push_back("--resume-or-restart");
@@ -495,7 +494,7 @@ std::vector<std::string> coupler_command(const RunOptions& o, const CoupledProce
 // A server died or stopped answering (the coupler exited 75): starts it again with the same
 // command and address and records the recovery in summary.json (`lost` = its lost_peer).
 void recover_server(const fs::path& out, CoupledProcesses& p, std::size_t i, nlohmann::json summary,
-                    const nlohmann::json& lost, int attempt, int recover) {
+                    const nlohmann::json& lost, int attempt, int recover, std::chrono::seconds port_wait) {
   auto log = fsi::logger("fsi");
   const std::string process = lost.value("process", std::string());
   const auto t0 = std::chrono::steady_clock::now();
@@ -507,7 +506,7 @@ void recover_server(const fs::path& out, CoupledProcesses& p, std::size_t i, nlo
     kill(p.children[i].pid, SIGKILL);
     reap(p.children[i], true);
   }
-  p.children[i] = start_server(p.servers[i], self_dir(), p.servers[i].endpoint, kPortFileWait);
+  p.children[i] = start_server(p.servers[i], self_dir(), p.servers[i].endpoint, port_wait);
   const nlohmann::json checkpoint = newest_checkpoint(out);
   const int from = checkpoint.is_object() ? checkpoint.value("step", 0) : 0;
   const double restart_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -550,7 +549,8 @@ Ending run_with_recovery(const RunOptions& o, CoupledProcesses& p, int recover, 
                           lost.value("cause", std::string("failed")), lost.value("step", 0), attempts,
                           attempts == 1 ? "y" : "ies")};
     ++attempts;
-    recover_server(out, p, process == "solid_server" ? 0 : 1, summary, lost, attempts, recover);
+    recover_server(out, p, process == "solid_server" ? 0 : 1, summary, lost, attempts, recover,
+                   std::chrono::seconds(o.start_timeout));
     resume = true;
   }
   return e;
@@ -833,6 +833,12 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
       ->add_option("--timeout", o.timeout,
                    "seconds the coupler waits for any single reply (a server that does not answer within it "
                    "counts as failed; a dead one is noticed at once)")
+      ->capture_default_str();
+  run_cmd
+      ->add_option("--start-timeout", o.start_timeout,
+                   "seconds a server may take to start (write its port file); the coupler's first request "
+                   "(Hello) waits half of it")
+      ->check(CLI::Range(2, 86400))
       ->capture_default_str();
   run_cmd->add_flag("--resume", o.resume, "continue the run in --out from its newest complete checkpoint");
   run_cmd->add_flag("--force", o.force, "replace the results of an earlier run in --out");

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Integration tests: the three processes over loopback (see harness.py)."""
 import math
+import re
 import os
 import signal
 import subprocess
@@ -403,22 +404,25 @@ def curve(env):
 def misbehaving_solid(env):
     """An external solid that never answers Hello, never writes its port file, answers as
     a fluid or with another protocol version: the launcher stops, names the cause, leaves
-    a final summary.json and no process behind, within its documented waits (port file
-    60 s, Hello 30 s, 1 s to exit after a failed run)."""
+    a final summary.json and no process behind, within its waits (--start-timeout 8 here:
+    port file 8 s, Hello 4 s; the defaults are 60 s and 30 s; 1 s to exit after a failed run)."""
     fake = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fake_solid.py")
-    expected = {"silent": "no reply from solid server", "noport": "did not report its endpoint within 60 s",
+    expected = {"silent": "no reply from solid server at ", "noport": "did not report its endpoint within 8 s",
                 "wrongkind": "is a SERVER_KIND_FLUID server, expected a SERVER_KIND_SOLID server",
                 "oldversion": "speaks protocol version 7 (HelloReply.protocol_version), this coupler 1"}
     for mode, text in expected.items():
         out = env.out(mode)
         start = time.time()
         code, log = env.fsi("sdof_model.yaml", out, timeout=120,
-                            extra=["--solid-command", f"{sys.executable} {fake} --mode {mode} --proto-dir {env.proto}"])
+                            extra=["--start-timeout", "8", "--solid-command",
+                                   f"{sys.executable} {fake} --mode {mode} --proto-dir {env.proto}"])
         elapsed = time.time() - start
         assert code == 1, (mode, code, log)
         s = summary(out)
         assert s["status"] == "failed" and text in s["reason"], (mode, s)
         assert text in log, (mode, log)
+        if mode == "silent":
+            assert re.search(r"within (39\d\d|4000) ms", s["reason"]), s  # Hello waits half of --start-timeout
         leftovers = []
         for pid in os.listdir("/proc"):
             if pid.isdigit():
