@@ -269,6 +269,36 @@ TEST(FluidInitialState, AnotherMeshAndElementStartFromACheckpoint) {
   EXPECT_NEAR(p.at("cyl_cd"), last.at("cyl_cd"), 0.15 * std::abs(last.at("cyl_cd")));  // measured 3.2568 -> 3.3928
 }
 
+// fluid.initial_state that is not a fluid's state is refused naming the key and what the file
+// is: a folder, a solid's state, a file that is no state at all (a missing file: the scene
+// reader's "'fluid.initial_state' file '...' does not exist", with the scene's line).
+TEST(FluidInitialState, WrongFilesAreNamedWithTheKey) {
+  const auto dir = std::filesystem::temp_directory_path() / ("fsi_wrong_initial_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  fsi::StateArchive solid;
+  solid.put("solid.displacement", Eigen::VectorXd::Zero(4).eval());
+  std::ofstream(dir / "solid.state", std::ios::binary) << solid.serialize();
+  std::ofstream(dir / "probes.csv") << "time,cd\n0.1,3.2\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {dir.string(), "is a folder: give the fluid.state of one of its checkpoints"},
+      {(dir / "solid.state").string(), "is not a fluid's state (no 'flow.*' entries; it holds solid.displacement)"},
+      {(dir / "probes.csv").string(), "not a solver state (no FSISTATE header"},
+  };
+  for (const auto& [file, expected] : cases) {
+    Case c;
+    c.extra = "  initial_state: " + file + "\n";
+    try {
+      Model m(c);
+      ADD_FAILURE() << file << " was accepted";
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("fluid.initial_state: " + file), std::string::npos) << what;
+      EXPECT_NE(what.find(expected), std::string::npos) << what;
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // The cylinder pushed towards the bottom wall, 0.025 a step (the gap 0.15 -> 0.025), with the
 // default (harmonic, from the mesh of the last remesh) motion: one step's motion folds an
 // element of a mesh that was above the quality threshold at the step's start. Without

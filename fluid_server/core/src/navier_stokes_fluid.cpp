@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -790,10 +791,28 @@ FluidMesh NavierStokesFluid::mesh_from_state(const StateArchive& state) {
 // starts from them with BDF1, a mesh at rest and zero interface velocity.
 void NavierStokesFluid::load_initial_state(const std::filesystem::path& file) {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto state = StateArchive::parse(read_text(file), file.string());
-  if (!state.has("remesh.nodes"))
+  const std::string where = "fluid.initial_state: " + file.string();
+  if (std::filesystem::is_directory(file))
     throw StateError(
-        fmt::format("{}: the checkpoint holds no fluid mesh (written before checkpoints held it)", file.string()));
+        fmt::format("{} is a folder: give the fluid.state of one of its checkpoints "
+                    "(checkpoints/step_N/fluid.state), or fsi run --initial-state RUN_DIR",
+                    where));
+  const auto state = StateArchive::parse(read_text(file), where);
+  if (!state.has("remesh.nodes")) {
+    const auto names = state.names();
+    const bool fluid =
+        std::any_of(names.begin(), names.end(), [](const std::string& n) { return n.rfind("flow.", 0) == 0; });
+    if (!fluid) {
+      std::string some;
+      for (std::size_t i = 0; i < names.size() && i < 3; ++i) some += (i ? ", " : "") + names[i];
+      throw StateError(
+          fmt::format("{} is not a fluid's state (no 'flow.*' entries; it holds {}{}): give a "
+                      "fluid.state of another run's checkpoint",
+                      where, names.empty() ? "nothing" : some, names.size() > 3 ? ", ..." : ""));
+    }
+    throw StateError(fmt::format(
+        "{}: the checkpoint holds no fluid mesh (written by an older build, before checkpoints held it)", where));
+  }
   FlowSolver old(mesh_from_state(state), solver_->parameters(), state.text("flow.element"));
   if (state.vector("flow.interface_velocity").size() > 0) old.set_interface(interface_groups_);
   old.load_state(state, "flow.");
