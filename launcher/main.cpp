@@ -676,8 +676,8 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
     refuse(fs::is_directory(out / "checkpoints")
                ? "no complete checkpoint in " + (out / "checkpoints").string() +
                      (skipped.empty() ? std::string() : " (" + skipped.front() + ")")
-               : "the run wrote no checkpoints (time.checkpoint_every: 0), so it cannot be continued; run it again "
-                 "into another --out, or with --force");
+               : "the run wrote no checkpoints (time.checkpoint_every is 0, or the run stopped before its first "
+                 "checkpoint), so it cannot be continued; run it again into another --out, or with --force");
   std::vector<std::string> overrides;
   for (const auto& ov : ckpt->manifest.value("overrides", nlohmann::json::array()))
     overrides.push_back(ov.get<std::string>());

@@ -46,11 +46,43 @@ nlohmann::json yaml_to_json(const YAML::Node& node) {
 
 }  // namespace
 
+namespace {
+// The files a run writes into --out (and only those: a user's own files stay).
+void remove_run_files(const std::filesystem::path& out_dir) {
+  for (const auto& e : std::filesystem::directory_iterator(out_dir)) {
+    const std::string name = e.path().filename().string();
+    const bool ours = name == "summary.json" || name == "summary.json.tmp" || name == "probes.csv" ||
+                      name == "iterations.csv" || name == "vtk" || name == "checkpoints" || name == ".ports" ||
+                      name == "solid_server.log" || name == "fluid_server.log" || name == "coupler.log" ||
+                      name == "commands.json" || name == "timing.csv";
+    if (ours) std::filesystem::remove_all(e.path());
+  }
+}
+
+// summary.json says the run failed before its first step, and there are no checkpoints.
+bool failed_before_first_step(const std::filesystem::path& out_dir) {
+  namespace fs = std::filesystem;
+  if (fs::is_directory(out_dir / "checkpoints") && !fs::is_empty(out_dir / "checkpoints")) return false;
+  std::ifstream in(out_dir / "summary.json");
+  if (!in) return false;
+  const auto summary = nlohmann::json::parse(in, nullptr, false);
+  return summary.is_object() && summary.value("status", "") == "failed" && summary.value("steps", -1) == 0 &&
+         summary.contains("reason") && summary["reason"].is_string() &&
+         summary["reason"].get<std::string>().rfind("while configuring", 0) == 0;
+}
+}  // namespace
+
 void prepare_output_dir(const std::filesystem::path& out_dir, OutputMode mode) {
   namespace fs = std::filesystem;
   if (fs::exists(out_dir) && !fs::is_directory(out_dir))
     throw std::runtime_error("--out '" + out_dir.string() + "' exists and is not a folder");
-  const bool empty = !fs::exists(out_dir) || fs::is_empty(out_dir);
+  bool empty = !fs::exists(out_dir) || fs::is_empty(out_dir);
+  if (!empty && mode == OutputMode::Fresh && failed_before_first_step(out_dir)) {
+    // A run that stopped while configuring (a missing file, a mesher's error) computed nothing:
+    // its files are replaced without --force, so the corrected run goes into the same --out.
+    remove_run_files(out_dir);
+    empty = true;  // (a user's own files in it stay, as with --force)
+  }
   if (!empty && mode == OutputMode::Fresh) {
     const bool checkpoints = fs::is_directory(out_dir / "checkpoints") && !fs::is_empty(out_dir / "checkpoints");
     throw std::runtime_error("--out '" + out_dir.string() + "' is not empty: " +
@@ -59,16 +91,7 @@ void prepare_output_dir(const std::filesystem::path& out_dir, OutputMode mode) {
                                           : "choose another --out, or pass --force to replace its results (it has "
                                             "no checkpoints to --resume from)"));
   }
-  if (!empty && mode == OutputMode::Force) {
-    for (const auto& e : fs::directory_iterator(out_dir)) {
-      const std::string name = e.path().filename().string();
-      const bool ours = name == "summary.json" || name == "summary.json.tmp" || name == "probes.csv" ||
-                        name == "iterations.csv" || name == "vtk" || name == "checkpoints" || name == ".ports" ||
-                        name == "solid_server.log" || name == "fluid_server.log" || name == "coupler.log" ||
-                        name == "commands.json";
-      if (ours) fs::remove_all(e.path());
-    }
-  }
+  if (!empty && mode == OutputMode::Force) remove_run_files(out_dir);
   fs::create_directories(out_dir);
 }
 

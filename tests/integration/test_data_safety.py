@@ -83,6 +83,29 @@ def invalid_scene(tmp):
     print("a refused scene wrote nothing; the corrected one ran into the same --out")
 
 
+def configure_error(tmp):
+    """A run that stops while configuring (here a missing fluid.initial_state) computed nothing:
+    the corrected run goes into the same --out without --force, a user's own file stays."""
+    out = os.path.join(tmp, "beam")
+    scene = "configs/thick_beam.yaml"
+    code, text = fsi("run", scene, "--out", out, "--set", "time.end=0.04",
+                     "--set", f"fluid.initial_state={tmp}/no_such.state")
+    assert code == 1 and "'fluid.initial_state' file" in text and "does not exist" in text, f"exit {code}:\n{text}"
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    assert summary["status"] == "failed" and summary["steps"] == 0, summary
+    with open(os.path.join(out, "notes.txt"), "w") as f:
+        f.write("mine\n")
+    run_ok(scene, "--out", out, "--set", "time.end=0.04")
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    assert summary["status"] == "completed" and summary["steps"] == 2, summary
+    assert open(os.path.join(out, "notes.txt")).read() == "mine\n", "a user's file in --out was touched"
+    # A run that computed steps is still protected.
+    refused_unchanged(out, [scene, "--out", out, "--set", "time.end=0.04"], "is not empty")
+    print("a run failed while configuring is replaced by the corrected one without --force; a completed one is not")
+
+
 def extend(tmp):
     """--resume --set time.end=T2 continues a completed run (its --set overrides from the
     checkpoint); the tables equal those of one run to T2."""
@@ -119,7 +142,7 @@ def study_invalid_case(tmp):
 
 
 CASES = {"study_invalid_case": study_invalid_case, "resume_without_checkpoints": resume_without_checkpoints, "resume_mismatched_scene": resume_mismatched_scene,
-         "invalid_scene": invalid_scene, "extend": extend}
+         "invalid_scene": invalid_scene, "extend": extend, "configure_error": configure_error}
 
 
 def main():
