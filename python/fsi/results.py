@@ -297,7 +297,9 @@ def run(scene, out, set=None, force=False, resume=False, solid_command=None, fsi
     if check and r.exit_code != 0:
         reason = r.reason
         if not reason:  # fsi stopped before writing a summary: its last error line
-            errors = [ln for ln in r.output.splitlines() if "[error]" in ln] or r.output.strip().splitlines() or ["no output"]
+            # (CLI11's usage hint "Run with --help ..." follows the real message: skip it)
+            out_lines = [ln for ln in r.output.strip().splitlines() if ln.strip() and not ln.startswith("Run with --help")]
+            errors = [ln for ln in out_lines if "[error]" in ln] or out_lines or ["no output"]
             reason = re.sub(r"^(\[[^\]]*\] )+", "", errors[-1].strip())
         raise RunError(f"fsi run {scene} --out {out}: {r.status or 'failed'} (exit code {r.exit_code}): {reason}",
                        r, reason)

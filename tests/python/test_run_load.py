@@ -77,6 +77,13 @@ except fsi.RunError as e:
     check(e.exit_code == 1 and e.status is None and "'coupling.relaxation' must be a number, got 'fast'" in e.reason
           and e.reason in str(e), f"bad value: exit {e.exit_code}, status {e.status}, reason: {e.reason}")
 try:
+    fsi.run(work / "no_such_scene.yaml", work / "missing", timeout=60)
+    check(False, "a missing scene raises RunError")
+except fsi.RunError as e:
+    # The command-line parser's message, not its "Run with --help" hint that follows it.
+    check(e.exit_code == 1 and "File does not exist" in e.reason and "no_such_scene.yaml" in e.reason,
+          f"missing scene: exit {e.exit_code}, reason: {e.reason}")
+try:
     fsi.run(SRC / "configs" / "added_mass.yaml", work / "am", set={"coupling.relaxation": 0.5}, timeout=60)
     check(False, "a diverging run raises RunError")
 except fsi.RunError as e:
