@@ -27,7 +27,7 @@ study = w / "sdof12.yaml"
 study.write_text(f"""
 study: sdof12
 scene: {SRC}/configs/sdof_model.yaml
-fixed: {{time.end: 5.0, time.dt: 0.01}}
+fixed: {{time.end: 2.0, time.dt: 0.01}}
 vary:
   coupling.gamma_n1: [0, 1, 10, 100]
   coupling.relaxation: [0.6, 0.8, 1.0]
