@@ -97,10 +97,12 @@ class NavierStokesFluid : public FluidModel {
   };
   FluidSetup setup_;
   std::string element_;  // fluid.element: p1p1 or p2p1
-  // fluid.dimension 3: the same FlowSolver on tetrahedra (fluid alone: no interface, no mesh motion).
+  // fluid.dimension 3: the same FlowSolver on tetrahedra, with a Nitsche interface of 6-node faces.
   std::unique_ptr<FlowSolver3> solver3_;
   std::vector<std::pair<std::string, Eigen::Vector3d>> pressure_probes3_;
   void configure3(const schema::Reader& section);
+  void configure_mesh_motion3(const schema::Reader& iface);
+  Eigen::MatrixX3d positions3(const Eigen::VectorXd& interface_displacement) const;
   std::map<std::string, double> probes3();
   std::unique_ptr<FlowSolver> solver_;
   FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
