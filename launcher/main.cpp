@@ -13,6 +13,7 @@
 // not be recovered, a crashed coupler), 130 interrupted (SIGINT / SIGTERM). Every way a run
 // ends leaves summary.json with its final status.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -36,6 +37,7 @@
 #include "fsi/common/config.hpp"
 #include "fsi/common/log.hpp"
 #include "fsi/common/run_report.hpp"
+#include "fsi/common/scene_reader.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/standalone.hpp"
 #include "fsi/common/version.hpp"
@@ -243,8 +245,64 @@ struct Server {
   std::string command;  // external command ("" = ours)
   std::string endpoint;
   fs::path port_file, log;
-  std::string curve_keys;  // CURVE key folder ("" = none)
+  std::string curve_keys;             // CURVE key folder ("" = none)
+  std::vector<std::string> mpi = {};  // our server under the MPI launcher (fluid.ranks > 1)
 };
+
+// The program on PATH (or a path with a slash, as given); "" if none.
+std::string find_program(const std::string& name) {
+  if (name.find('/') != std::string::npos) return access(name.c_str(), X_OK) == 0 ? name : "";
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  std::size_t start = 0;
+  while (start <= dirs.size()) {
+    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+    const fs::path candidate = fs::path(dirs.substr(start, end - start)) / name;
+    if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
+    start = end + 1;
+  }
+  return "";
+}
+
+// fluid.ranks > 1: the command line that starts fluid_server on that many MPI ranks
+// (fluid.mpi: command, hostfile, args); empty for one rank (no MPI launcher at all).
+std::vector<std::string> fluid_mpi_launcher(const fsi::Scene& scene) {
+  if (!scene.has("fluid.ranks")) return {};
+  // fluid.ranks and fluid.mpi are keys of the fem fluid (navier_stokes_keys.cpp).
+  const auto& variants = fsi::models::fluid_section().variants;
+  const auto fem = std::find_if(variants.begin(), variants.end(), [](const auto& v) { return v.value == "fem"; });
+  if (fem == variants.end()) return {};
+  const fsi::ConfigSection section = scene.section("fluid");
+  const fsi::schema::Reader fluid(section, fem->keys);
+  const int ranks = fluid.get<int>("ranks");
+  if (ranks <= 1) return {};
+  const auto mpi_key =
+      std::find_if(fem->keys.begin(), fem->keys.end(), [](const fsi::schema::Key& k) { return k.name == "mpi"; });
+  const fsi::schema::Reader mpi(section.child_or_empty("mpi"), mpi_key->children);
+  const auto command = mpi.get<std::string>("command");
+  const std::string hostfile = mpi.has("hostfile") ? mpi.path("hostfile").string() : "";
+  const auto args = mpi.get<std::vector<std::string>>("args");
+  const std::string program = find_program(command);
+  if (program.empty())
+    throw fsi::ConfigError(fmt::format(
+        "fluid.ranks: {} needs the MPI launcher '{}' (fluid.mpi.command), which is not on PATH (Debian: apt-get "
+        "install openmpi-bin)",
+        ranks, command));
+  const bool placed = !hostfile.empty() || std::any_of(args.begin(), args.end(), [](const std::string& a) {
+    return a == "--oversubscribe" || a == "--host" || a == "-H" || a == "--hostfile" || a == "--machinefile";
+  });
+  const unsigned cores = std::thread::hardware_concurrency();
+  if (!placed && cores > 0 && static_cast<unsigned>(ranks) > cores)
+    throw fsi::ConfigError(
+        fmt::format("fluid.ranks: {} ranks but this host has {} cores: run on several hosts (fluid.mpi.hostfile) or "
+                    "oversubscribe (fluid.mpi.args: [--oversubscribe])",
+                    ranks, cores));
+  std::vector<std::string> argv{program, "-n", std::to_string(ranks)};
+  if (geteuid() == 0) argv.push_back("--allow-run-as-root");
+  if (!hostfile.empty()) argv.insert(argv.end(), {"--hostfile", hostfile});
+  argv.insert(argv.end(), args.begin(), args.end());
+  return argv;
+}
 
 Child start_server(Server& s, const fs::path& bin, const std::string& bind, std::chrono::seconds timeout) {
   const std::string server = s.side + "_server";
@@ -253,6 +311,7 @@ Child start_server(Server& s, const fs::path& bin, const std::string& bind, std:
   if (s.command.empty()) {
     std::vector<std::string> argv{(bin / server).string(), "--bind", bind, "--port-file", s.port_file.string()};
     if (!s.curve_keys.empty()) argv.insert(argv.end(), {"--curve-keys", s.curve_keys});
+    argv.insert(argv.begin(), s.mpi.begin(), s.mpi.end());
     c = spawn(server, argv, s.log);
   } else {
     std::string shell = fmt::format("exec {} --bind '{}' --port-file '{}'", s.command, bind, s.port_file.string());
@@ -362,6 +421,11 @@ int run_single(const RunOptions& o, const fsi::Scene& scene, const std::vector<s
     const std::string server = has_solid ? "solid_server" : "fluid_server";
     std::vector<std::string> argv{(self_dir() / server).string(), "--standalone", o.scene_path, "--out", o.out_dir};
     argv.insert(argv.end(), sets.begin(), sets.end());
+    if (has_fluid) {
+      const auto mpi = fluid_mpi_launcher(scene);
+      argv.insert(argv.begin(), mpi.begin(), mpi.end());
+      if (!mpi.empty()) log->info("fluid on {} MPI ranks: {}", mpi[2], fmt::join(mpi, " "));
+    }
     log->info("scene '{}': {} alone", o.scene_path, server);
     main = spawn(server, argv, "");
     wait_forwarding_signals(main, std::chrono::milliseconds(20), false);
@@ -390,11 +454,13 @@ struct CoupledProcesses {
 };
 
 // Starts both servers on free loopback ports.
-void start_servers(const RunOptions& o, const fs::path& ports, CoupledProcesses& p) {
+void start_servers(const RunOptions& o, const fs::path& ports, CoupledProcesses& p,
+                   const std::vector<std::string>& fluid_mpi) {
   auto log = fsi::logger("fsi");
   fs::create_directories(ports);
   for (const auto& [side, command] : {std::pair{std::string("solid"), o.solid_command}, {"fluid", o.fluid_command}}) {
     Server s{side, command, "", ports / (side + ".port"), fs::path(o.out_dir) / (side + "_server.log"), o.curve_keys};
+    if (side == "fluid" && command.empty()) s.mpi = fluid_mpi;
     const std::size_t i = side == "solid" ? 0 : 1;
     p.children[i] = start_server(s, self_dir(), "tcp://127.0.0.1:*", kPortFileWait);
     log->info("{} listening on {} (log: {})", p.children[i].name, s.endpoint, s.log.string());
@@ -542,7 +608,7 @@ int run_coupled(const RunOptions& o, const fsi::Scene& scene, const std::vector<
     const int recover = o.recover < 0 ? (every > 0 ? 3 : 0) : o.recover;
     if (recover > 0 && every == 0)
       log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
-    start_servers(o, ports, p);
+    start_servers(o, ports, p, fluid_mpi_launcher(scene));
     e = run_with_recovery(o, p, recover, sets);
     after_coupler(p, e);
   } catch (const std::exception& ex) {

@@ -7,6 +7,7 @@ packages=(
   libprotobuf-dev protobuf-compiler libzmq3-dev cppzmq-dev
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libgtest-dev
   gmsh libgmsh-dev   # the gmsh CLI (meshing .geo files) and its C++ API (remeshing)
+  libpetsc-real-dev openmpi-bin libopenmpi-dev   # the fluid's PETSc engines (petsc, mumps) and MPI ranks (fluid.ranks)
   python3 python3-zmq python3-protobuf python3-yaml python3-matplotlib python3-psutil
   python3-numpy python3-scipy python3-pandas python3-distributed python3-nbformat
   python3-venv python3-setuptools python3-wheel

@@ -9,8 +9,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "fsi/common/config.hpp"
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/fluid/flow_solver.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 #include "fsi/fluid/p2p1_tet_element.hpp"
 
 namespace {
@@ -127,7 +129,7 @@ TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
   for (int i = 0; i < solver.mesh().node_count(); ++i)
     err = std::max(err, (v.row(i).transpose() - exact(solver.mesh().nodes.row(i).transpose(), 0)).norm());
   EXPECT_LT(err, 1e-10);
-  for (const Eigen::Vector3d& x : {Eigen::Vector3d(0.3, 0.4, 0.2), Eigen::Vector3d(1.7, 0.9, 0.45)}) {
+  for (const Eigen::Vector3d x : {Eigen::Vector3d(0.3, 0.4, 0.2), Eigen::Vector3d(1.7, 0.9, 0.45)}) {
     EXPECT_NEAR(solver.pressure_at(x), 8 * mu * U * (L - x.x()) / (H * H), 1e-9);
     EXPECT_NEAR(solver.velocity_at(x).x(), 4 * U * x.y() * (H - x.y()) / (H * H), 1e-10);
   }
@@ -144,6 +146,78 @@ TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
   EXPECT_NEAR(f.z(), 0, 1e-9);
   // The walls and the inlet separately are far from zero: the sum is not trivially small.
   EXPECT_GT(std::abs(solver.force({"bottom"}).x()), 0.5 * 4 * mu * U / H * L * W);
+}
+
+// The plane Poiseuille problem above on the given engine: the largest nodal velocity error.
+struct PoiseuilleRun {
+  double velocity_error = 0, pressure_error = 0;
+  int krylov_iterations = 0;
+  Eigen::VectorXd solution;
+};
+PoiseuilleRun poiseuille(LinearEngine engine, const std::string& petsc_options = "") {
+  const double L = 2, H = 1, U = 1.5, mu = 0.1;
+  FlowParameters params;
+  params.viscosity = mu;
+  params.scheme = TimeScheme::Steady;
+  params.newton = true;
+  params.max_iterations = 8;
+  params.tolerance = 1e-12;
+  params.stabilisation.supg = false;
+  params.reuse_factorisation = false;
+  params.engine = engine;
+  params.petsc_options = petsc_options;
+  FlowSolver3 solver(TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1), params, "p2p1");
+  auto exact = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
+    return {4 * U * x.y() * (H - x.y()) / (H * H), 0, 0};
+  };
+  for (const char* g : {"left", "bottom", "top"}) solver.add_dirichlet(g, exact);
+  solver.add_symmetry("back");
+  solver.add_symmetry("front");
+  const auto report = solver.solve(1, 1, solver.mesh().nodes, {});
+  PoiseuilleRun run;
+  run.krylov_iterations = report.krylov_iterations;
+  const auto v = solver.velocity();
+  for (int i = 0; i < solver.mesh().node_count(); ++i)
+    run.velocity_error =
+        std::max(run.velocity_error, (v.row(i).transpose() - exact(solver.mesh().nodes.row(i).transpose(), 0)).norm());
+  const Eigen::Vector3d x(1.7, 0.9, 0.45);
+  run.pressure_error = std::abs(solver.pressure_at(x) - 8 * mu * U * (L - x.x()) / (H * H));
+  run.solution = solver.solution();
+  return run;
+}
+
+TEST(FlowSolver3, PetscEnginesSolvePoiseuilleAsUmfpack) {
+  if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
+  const auto lu = poiseuille(LinearEngine::Umfpack);
+  EXPECT_LT(lu.velocity_error, 1e-10);
+  // The field-split GMRES (default preconditioner) converges; with a tight tolerance its
+  // solution is the LU one.
+  const auto iterative = poiseuille(LinearEngine::Petsc, "-ksp_rtol 1e-13");
+  EXPECT_GT(iterative.krylov_iterations, 0);
+  EXPECT_LT(iterative.velocity_error, 1e-10);
+  EXPECT_LT(iterative.pressure_error, 1e-9);
+  EXPECT_LT((iterative.solution - lu.solution).lpNorm<Eigen::Infinity>(), 1e-9);
+  const auto mumps = poiseuille(LinearEngine::Mumps);
+  EXPECT_LT(mumps.velocity_error, 1e-10);
+  EXPECT_LT((mumps.solution - lu.solution).lpNorm<Eigen::Infinity>(), 1e-10);
+}
+
+TEST(FlowSolver3, PetscRefusesAnUnknownOptionNamingIt) {
+  if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
+  try {
+    (void)poiseuille(LinearEngine::Petsc, "-ksp_rtol 1e-12 -ksp_no_such_option 3");
+    FAIL() << "an unknown PETSc option was accepted";
+  } catch (const fsi::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("-ksp_no_such_option"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("ksp_rtol"), std::string::npos) << e.what();
+  }
+  // An option with a value PETSc does not know fails with PETSc's message naming the value.
+  try {
+    (void)poiseuille(LinearEngine::Petsc, "-ksp_type no_such_krylov");
+    FAIL() << "an unknown KSP type was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_krylov"), std::string::npos) << e.what();
+  }
 }
 
 // A box whose whole boundary is the Nitsche interface, moving with a uniform velocity V: the

@@ -17,7 +17,7 @@
 #include "flow_element.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/field_transfer.hpp"
-#include "fsi/fluid/sparse_lu.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -177,7 +177,7 @@ struct BasicFlowSolver<Dim>::Impl {
   std::vector<int> scatter;                    // per triangle local x local positions in valuePtr (column-major local)
   Eigen::SparseMatrix<double> matrix, volume;  // the system (constraints applied); the volume terms (reactions)
   Eigen::VectorXd rhs, rhs_volume;
-  std::unique_ptr<SparseLu> lu;
+  std::unique_ptr<LinearSolver> lu;
   std::vector<DirichletCondition<Dim>> dirichlet;
   std::vector<SymmetryCondition> symmetry;
   std::vector<detail::InterfaceEdge> edges;
@@ -319,7 +319,9 @@ BasicFlowSolver<Dim>::BasicFlowSolver(Mesh mesh, FlowParameters params, const st
   auto& im = *impl_;
   im.element = make_element(element, std::move(mesh));
   im.dof = im.element->layout();
-  im.lu = std::make_unique<SparseLu>(params_);
+  std::vector<char> pressure(static_cast<std::size_t>(im.dof.dofs), 0);
+  for (int v = 0; v < im.mesh().vertices(); ++v) pressure[static_cast<std::size_t>(im.dof.pressure(v))] = 1;
+  im.lu = make_linear_solver(params_, Dim, std::move(pressure));
   im.build_pattern();
   U_ = U_n_ = U_nm1_ = reaction_ = Eigen::VectorXd::Zero(im.dof.dofs);
   X_ = X_n_ = X_nm1_ = im.mesh().nodes;
@@ -488,6 +490,7 @@ typename BasicFlowSolver<Dim>::Step BasicFlowSolver<Dim>::begin_step(double time
   s.alpha0_dt = steady ? 0.0 : alpha0 / dt;
   s.mesh_velocity = Nodes::Zero(n, Dim);
   if (!steady) s.mesh_velocity = (alpha0 * X_ + alpha1 * X_n_ + alpha2 * X_nm1_) / dt;
+  if (params_.mesh_velocity_scale != 1.0) s.mesh_velocity *= params_.mesh_velocity_scale;
   s.U_lin = steady ? U_n_ : Eigen::VectorXd((1 + extrap) * U_n_ - extrap * U_nm1_);
   // A later coupling iteration of the step starts its linear solve from the last iterate's
   // solution (closer than the extrapolation; the system solved is the same).

@@ -1,9 +1,13 @@
 #include "fsi/fluid/mesh_quality.hpp"
 
+#include <fmt/format.h>
+
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
 #include "fsi/fluid/p2p1_element.hpp"
+#include "fsi/fluid/p2p1_tet_element.hpp"
 
 namespace fsi::fluid {
 
@@ -62,6 +66,90 @@ MeshQuality mesh_quality(const FluidMesh& mesh, const Eigen::MatrixX2d& position
   }
   if (mesh.triangle_count() == 0) q.min_scaled_jacobian = 1, q.max_angle_deg = 60;
   return q;
+}
+
+namespace {
+
+struct TetShape {
+  double six_volume, scaled_jacobian, shape;
+};
+
+// Scaled Jacobian and mean-ratio shape quality of the straight tetrahedron x (rows: vertices).
+TetShape tet_shape(const Eigen::Matrix<double, 4, 3>& x) {
+  Eigen::Matrix3d J;
+  for (int k = 0; k < 3; ++k) J.col(k) = (x.row(k + 1) - x.row(0)).transpose();
+  const double det = J.determinant();  // 6 V
+  double len2[4][4] = {};
+  double sum = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) {
+      len2[a][b] = len2[b][a] = (x.row(a) - x.row(b)).squaredNorm();
+      sum += len2[a][b];
+    }
+  double corner = 0;  // largest product of the three edge lengths at a corner
+  for (int a = 0; a < 4; ++a) {
+    double p = 1;
+    for (int b = 0; b < 4; ++b)
+      if (b != a) p *= len2[a][b];
+    corner = std::max(corner, std::sqrt(p));
+  }
+  TetShape s{det, 0.0, 0.0};
+  if (corner == 0 || sum == 0) return s;
+  s.scaled_jacobian = std::sqrt(2.0) * det / corner;
+  s.shape = std::copysign(12.0 * std::cbrt(0.25 * det * det) / sum, det);  // (3 |V|)^(2/3) = (|det| / 2)^(2/3)
+  return s;
+}
+
+}  // namespace
+
+TetMeshQuality mesh_quality(const TetMesh& mesh, const Eigen::MatrixX3d& positions) {
+  TetMeshQuality q;
+  if (mesh.cell_count() == 0) return q;
+  q.min_scaled_jacobian = q.min_shape = q.min_volume_ratio = 1e300;
+  for (int e = 0; e < mesh.cell_count(); ++e) {
+    Eigen::Matrix<double, 4, 3> x, x0;
+    for (int k = 0; k < 4; ++k) {
+      x.row(k) = positions.row(mesh.tets(e, k));
+      x0.row(k) = mesh.nodes.row(mesh.tets(e, k));
+    }
+    const TetShape s = tet_shape(x), s0 = tet_shape(x0);
+    bool bad = s.six_volume <= 0;
+    if (s.scaled_jacobian < q.min_scaled_jacobian) {
+      q.min_scaled_jacobian = s.scaled_jacobian;
+      q.worst_element = e;
+      q.worst_centre = x.colwise().mean().transpose();
+    }
+    q.min_shape = std::min(q.min_shape, s.shape);
+    if (s0.six_volume > 0) q.min_volume_ratio = std::min(q.min_volume_ratio, s.six_volume / s0.six_volume);
+    if (mesh.quadratic()) {
+      const auto nodes = mesh.element_nodes10(e);
+      Eigen::Matrix<double, 10, 3> xc;
+      for (int k = 0; k < 10; ++k) xc.row(k) = positions.row(nodes(k));
+      const double curved =
+          s.six_volume <= 0 ? (s.six_volume == 0 ? 0.0 : -1.0) : p2_tet_min_jacobian(xc) / s.six_volume;
+      if (curved < q.min_curved_jacobian) {
+        q.min_curved_jacobian = curved;
+        q.worst_curved_element = e;
+        q.worst_curved_centre = x.colwise().mean().transpose();
+      }
+      bad = bad || curved <= 0;
+    }
+    q.inverted += bad;
+  }
+  return q;
+}
+
+std::string TetMeshQuality::describe() const {
+  std::string s = fmt::format(
+      "min scaled Jacobian {:.3g} (tetrahedron {} near ({:.5g}, {:.5g}, {:.5g})), min shape {:.3g}, "
+      "min volume ratio {:.3g}",
+      min_scaled_jacobian, worst_element, worst_centre.x(), worst_centre.y(), worst_centre.z(), min_shape,
+      min_volume_ratio);
+  if (worst_curved_element >= 0)
+    s += fmt::format(", min curved Jacobian {:.3g} (tetrahedron {} near ({:.5g}, {:.5g}, {:.5g}))", min_curved_jacobian,
+                     worst_curved_element, worst_curved_centre.x(), worst_curved_centre.y(), worst_curved_centre.z());
+  if (inverted > 0) s += fmt::format(", {} inverted", inverted);
+  return s;
 }
 
 }  // namespace fsi::fluid

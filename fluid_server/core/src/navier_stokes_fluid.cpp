@@ -15,6 +15,8 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/scene_reader.hpp"
 #include "fsi/fluid/field_transfer.hpp"
+#include "fsi/fluid/flow_vtk.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 #include "fsi/fluid/mesh_quality.hpp"
 #include "fsi/fluid/remesh.hpp"
 
@@ -152,13 +154,42 @@ void read_stabilisation(const schema::Reader& section, bool taylor_hood, Stabili
   }
 }
 
-// threads, umfpack_irstep, linear_solver.
-void read_linear_solver(const schema::Reader& section, bool taylor_hood, FlowParameters& params) {
+// threads, umfpack_irstep, ranks, linear_solver. The default engine: UMFPACK in 2D; PETSc in 3D
+// when built with it (DFG 3D-1Z: 2.6x faster than UMFPACK at 31.6k unknowns, 4.8x at 76.8k with
+// 42 % of its memory; docs/fluid.md).
+void read_linear_solver(const schema::Reader& section, bool taylor_hood, int dimension, FlowParameters& params) {
   params.threads = section.get<int>("threads");
   params.umfpack_irstep = section.get<int>("umfpack_irstep");
   if (taylor_hood) params.strategy = LuStrategy::Symmetric;
   const auto ls = section.optional_child("linear_solver");
-  if (!ls) return;
+  // Measured on DFG 3D-1Z (docs/fluid.md): the matrices of successive Newton iterations differ
+  // too much for a kept preconditioner (twice the iterations); time steps differ little.
+  params.petsc_reuse_preconditioner = params.scheme != TimeScheme::Steady;
+  params.engine = dimension == 3 && petsc_available() ? LinearEngine::Petsc : LinearEngine::Umfpack;
+  const int ranks = section.get<int>("ranks");
+  (void)section.declared("mpi");  // read by the launcher (fsi run)
+  if (ranks != mpi_world_size())
+    section.fail("ranks", fmt::format("is {} but this fluid_server runs on {} MPI rank(s): fsi run starts it under "
+                                      "mpirun -n {} (or start it so yourself)",
+                                      ranks, mpi_world_size(), ranks));
+  if (!ls) {
+    if (ranks > 1 && params.engine == LinearEngine::Umfpack)
+      section.fail("ranks", "needs fluid.linear_solver.engine: petsc or mumps (UMFPACK runs on one rank)");
+    return;
+  }
+  const auto engine = ls->get_or<std::string>("engine", params.engine == LinearEngine::Petsc ? "petsc" : "umfpack");
+  params.engine = engine == "petsc"   ? LinearEngine::Petsc
+                  : engine == "mumps" ? LinearEngine::Mumps
+                                      : LinearEngine::Umfpack;
+  if (ranks > 1 && params.engine == LinearEngine::Umfpack)
+    section.fail("ranks", "needs fluid.linear_solver.engine: petsc or mumps (UMFPACK runs on one rank)");
+  if (params.engine != LinearEngine::Umfpack && !petsc_available())
+    ls->fail("engine", "this build has no PETSc (install libpetsc-real-dev, scripts/install-deps.sh, and reconfigure)");
+  params.petsc_options = ls->get<std::string>("petsc_options");
+  if (params.engine == LinearEngine::Umfpack && !params.petsc_options.empty())
+    ls->fail("petsc_options", "is for the petsc and mumps engines (engine is umfpack)");
+  params.petsc_reuse_preconditioner = ls->get_or<bool>("petsc_reuse_preconditioner", params.petsc_reuse_preconditioner);
+  params.petsc_rebuild_factor = ls->get<double>("petsc_rebuild_factor");
   const auto ordering = ls->get<std::string>("ordering");
   params.ordering = ordering == "metis" ? Ordering::Metis : ordering == "amd" ? Ordering::Amd : Ordering::Auto;
   const auto strategy = ls->get_or<std::string>("strategy", taylor_hood ? "symmetric" : "auto");
@@ -345,7 +376,7 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
   FlowParameters params;
   read_physics(section, taylor_hood, params);
   read_stabilisation(section, taylor_hood, params.stabilisation);
-  read_linear_solver(section, taylor_hood, params);
+  read_linear_solver(section, taylor_hood, 2, params);
   const auto interface_groups = read_nitsche(section, setup, params);
   read_remesh(section, !interface_groups.empty());
   if (remesh_.enabled || !remesh_.at_steps.empty()) original_mesh_ = mesh;  // a checkpoint before the first remesh
@@ -388,7 +419,7 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
   read_physics(section, true, params);
   read_stabilisation(section, true, params.stabilisation);
   if (params.stabilisation.supg) section.fail("stabilisation", "the 3D fluid has no SUPG (grad-div only)");
-  read_linear_solver(section, true, params);
+  read_linear_solver(section, true, 3, params);
   const auto interface_groups = read_nitsche(section, setup_, params);
   solver3_ = std::make_unique<FlowSolver3>(std::move(mesh), params, element_);
   const auto& m = solver3_->mesh();
@@ -488,6 +519,7 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
       "fluid: 3D p2p1 (Taylor-Hood), {} nodes, {} tetrahedra, {} unknowns, scheme {}, {}, {} interface nodes, mesh {}",
       m.node_count(), m.cell_count(), solver3_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard",
       solver3_->interface_nodes().size(), msh.string());
+  configure_vtk(section);
   start_ = last_log_ = std::chrono::steady_clock::now();
 }
 
@@ -508,7 +540,13 @@ std::map<std::string, double> NavierStokesFluid::probes3() {
   for (const auto& [name, pair] : pressure_differences_) probes[name] = probes.at(pair.first) - probes.at(pair.second);
   probes["nonlinear_iterations"] = last_report_.iterations;
   probes["nonlinear_change"] = last_report_.change;
+  if (motion3_) {  // the moving mesh's quality (fsi/fluid/mesh_quality.hpp)
+    const TetMeshQuality q = mesh_quality(solver3_->mesh(), solver3_->accepted_positions());
+    probes["mesh_min_scaled_jacobian"] = q.min_scaled_jacobian;
+    probes["mesh_min_curved_jacobian"] = q.min_curved_jacobian;
+  }
   probes["factorisations"] = factorisations_;
+  probes["linear_iterations"] = linear_iterations_;  // Krylov iterations so far (3D only: 2D outputs unchanged)
   return probes;
 }
 
@@ -654,8 +692,12 @@ void NavierStokesFluid::configure_output(const schema::Reader& section, double d
           pd->fail(k, "unknown pressure probe '" + p + "'");
       pressure_differences_.push_back({k, {pair[0], pair[1]}});
     }
-  // VTK whenever the run asks (time.output_every), unless output.vtk_every says otherwise:
-  // N > 0 = only at steps that are multiples of N, 0 = never.
+  configure_vtk(section);
+}
+
+// VTK whenever the run asks (time.output_every), unless output.vtk_every says otherwise:
+// N > 0 = only at steps that are multiples of N, 0 = never. Both dimensions (flow_vtk.hpp).
+void NavierStokesFluid::configure_vtk(const schema::Reader& section) {
   if (auto out = section.optional_child("output")) {
     vtk_every_ = out->get_or<int>("vtk_every", -1);
   }
@@ -864,16 +906,26 @@ Eigen::MatrixX2d NavierStokesFluid::extend(const Eigen::VectorXd& interface_disp
   return out;
 }
 
-// 3D: the mesh motion of the interface (fluid.interface's mesh_motion keys).
+// 3D: the mesh motion of the interface (fluid.interface's mesh_motion keys): MeshMotion3 on the
+// 10-node tetrahedra (extended on the vertices; interface midpoints follow the interface,
+// interior ones the mean of their edge), the groups with conditions held fixed.
 void NavierStokesFluid::configure_mesh_motion3(const schema::Reader& iface) {
-  (void)iface.get<std::string>("mesh_motion");
+  MeshMotionOptions& motion = motion_options_;
+  motion.stiffening = iface.get<double>("mesh_stiffening");
+  if (iface.get<std::string>("mesh_motion") == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
+  motion.incremental = iface.get<bool>("mesh_incremental");
+  if (iface.get<std::string>("mesh_motion_nodes") != "vertices")
+    iface.fail("mesh_motion_nodes", "the 3D fluid extends the displacement on the vertices only");
+  const auto& mesh = solver3_->mesh();
+  motion3_ = std::make_unique<MeshMotion3>(mesh, solver3_->interface_nodes(), mesh.boundary_nodes(fixed_groups_),
+                                           motion_options_);  // keeps a pointer to the solver's mesh
 }
 
 // 3D: every node's position for the interface displacement (3 per interface node).
-Eigen::MatrixX3d NavierStokesFluid::positions3(const Eigen::VectorXd& interface_displacement) const {
-  const auto& nodes = solver3_->mesh().nodes;
-  if (interface_displacement.size() == 0 || interface_displacement.cwiseAbs().maxCoeff() == 0) return nodes;
-  throw std::invalid_argument("the 3D fluid's mesh does not move yet (a nonzero interface displacement)");
+Eigen::MatrixX3d NavierStokesFluid::positions3(const Eigen::VectorXd& interface_displacement) {
+  if (!motion3_ || interface_displacement.size() == 0) return solver3_->mesh().nodes;
+  last_interface_displacement_ = interface_displacement;
+  return motion3_->positions(interface_displacement);
 }
 
 InterfaceMeshData NavierStokesFluid::interface() const {
@@ -915,6 +967,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
     solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++solves_;
     factorisations_ += last_report_.factorisations;
+    linear_iterations_ += last_report_.krylov_iterations;
     assembly_seconds_ += last_report_.assembly_seconds;
     factor_seconds_ += last_report_.factor_seconds;
     linear_solve_seconds_ += last_report_.solve_seconds;
@@ -964,6 +1017,8 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
   if (solver3_) {
     solver3_->accept();
+    if (motion3_ && last_interface_displacement_.size() > 0) motion3_->accept(last_interface_displacement_);
+    accepted_interface_displacement_ = last_interface_displacement_;
     return probes3();
   }
   solver_->accept();
@@ -1033,7 +1088,12 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
 }
 
 void NavierStokesFluid::save_state(StateArchive& state) {
-  if (solver3_) return solver3_->save_state(state, "flow.");
+  if (solver3_) {
+    solver3_->save_state(state, "flow.");
+    if (motion3_) motion3_->save_state(state, "mesh.");
+    state.put("fluid.last_interface_displacement", last_interface_displacement_);
+    return;
+  }
   if (!solver_) throw std::logic_error("NavierStokesFluid::save_state before configure()");
   solver_->save_state(state, "flow.");
   if (motion_) motion_->save_state(state, "mesh.");
@@ -1044,7 +1104,24 @@ void NavierStokesFluid::save_state(StateArchive& state) {
 }
 
 void NavierStokesFluid::load_state(const StateArchive& state) {
-  if (solver3_) return solver3_->load_state(state, "flow.");
+  if (solver3_) {
+    if (!motion3_ && state.has("mesh.base_displacement"))
+      throw StateError(
+          "entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
+    const Eigen::VectorXd last = state.has("fluid.last_interface_displacement")
+                                     ? state.vector("fluid.last_interface_displacement")
+                                     : Eigen::VectorXd();
+    const auto interface_size = 3 * static_cast<Eigen::Index>(solver3_->interface_nodes().size());
+    if (last.size() != 0 && last.size() != interface_size)
+      throw StateError(
+          fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration "
+                      "needs {} (a different mesh or scene?)",
+                      last.size(), interface_size));
+    solver3_->load_state(state, "flow.");
+    if (motion3_) motion3_->load_state(state, "mesh.");
+    last_interface_displacement_ = accepted_interface_displacement_ = last;
+    return;
+  }
   if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
   if (const auto saved = state.text("flow.element"); saved != element_)
     throw StateError(
@@ -1071,18 +1148,8 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
 }
 
 std::vector<std::string> NavierStokesFluid::write_output(const StepInfo& info) {
-  if (solver3_) return {};  // no VTK tetrahedra yet
   if (vtk_every_ == 0 || setup_.output_dir.empty() || (vtk_every_ > 0 && info.step % vtk_every_ != 0)) return {};
-  const auto mesh = solver_->mesh().linear_refinement();  // P2: 4 linear triangles per element
-  VtkGrid grid;
-  grid.points = solver_->positions();
-  for (int e = 0; e < mesh.triangle_count(); ++e) {
-    grid.cells.push_back({mesh.triangles(e, 0), mesh.triangles(e, 1), mesh.triangles(e, 2)});
-    grid.cell_types.push_back(VtkCellType::Triangle);
-  }
-  grid.point_data["velocity"] = solver_->velocity();
-  grid.point_data["pressure"] = solver_->pressure();
-  grid.point_data["mesh_displacement"] = solver_->positions() - mesh.nodes;
+  const VtkGrid grid = solver3_ ? flow_vtk_grid(*solver3_) : flow_vtk_grid(*solver_);
   return {vtk_.write(info.time, info.step, grid).string()};
 }
 

@@ -59,9 +59,42 @@ const std::vector<schema::Key>& navier_stokes_keys() {
                   .only_when(element, {"p2p1"}, "p1p1"),
           }),
       integer("threads", "assembly threads (OpenMP)").def("1"),
+      integer("ranks",
+              "MPI ranks of the fluid (fsi run starts fluid_server under mpirun -n N; engine petsc or mumps): "
+              "rank 0 assembles, all ranks solve")
+          .def("1")
+          .ge(1),
+      section(
+          "mpi", "how fsi run starts a fluid with ranks > 1",
+          {
+              text("command", "the MPI launcher (PATH is searched)").def("mpirun"),
+              text("hostfile", "mpirun --hostfile: the hosts of the ranks (relative to the scene file)"),
+              string_list("args", "further launcher arguments, e.g. [--oversubscribe] or [--host, a:2,b:2]").def("[]"),
+          }),
       integer("umfpack_irstep", "UMFPACK iterative refinement steps").def("0").ge(0).le(2),
-      section("linear_solver", "sparse LU (UMFPACK) and its reuse as a BiCGSTAB preconditioner",
+      section("linear_solver",
+              "the linear-algebra engine: sparse LU (UMFPACK) and its reuse as a BiCGSTAB preconditioner, or PETSc "
+              "(docs/fluid.md, Linear-algebra engines)",
               {
+                  choice("engine", {"umfpack", "petsc", "mumps"},
+                         "umfpack: UMFPACK LU (the settings below); petsc: PETSc GMRES with a field-split Schur "
+                         "preconditioner (ILU(0) velocity, BoomerAMG on the selfp Schur complement); mumps: the "
+                         "MUMPS direct solver through PETSc")
+                      .def_computed("umfpack in 2D; petsc in 3D (umfpack in a build without PETSc)"),
+                  text("petsc_options",
+                       "petsc / mumps: further PETSc options after the engine's defaults, e.g. \"-ksp_rtol 1e-12\" "
+                       "(the KSP's and its PC's options, sub-solvers as -fieldsplit_u_* / -fieldsplit_p_*); an "
+                       "option the solver does not use is refused")
+                      .def("\"\""),
+                  boolean("petsc_reuse_preconditioner",
+                          "petsc: keep the preconditioner of an earlier matrix while it works (a kept one that "
+                          "needs more iterations than petsc_rebuild_factor allows is replaced within the solve)")
+                      .def_computed("false when steady (Newton iterations), true with BDF time steps"),
+                  number("petsc_rebuild_factor",
+                         "petsc: rebuild once a solve needs more than this times the iterations of the "
+                         "preconditioner's first solve (+ 5)")
+                      .def("1.5")
+                      .ge(1),
                   choice("ordering", {"auto", "metis", "amd"}, "fill-reducing ordering").def("auto"),
                   choice("strategy", {"auto", "symmetric", "unsymmetric"}, "UMFPACK strategy")
                       .def_computed("symmetric (P2/P1), auto (P1/P1)"),

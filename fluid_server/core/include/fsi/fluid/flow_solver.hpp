@@ -1,8 +1,9 @@
 #pragma once
 // The fluid solver: Navier-Stokes in ALE form on a (moving) triangle mesh, with strong
 // Dirichlet and symmetry conditions, do-nothing outlets, a Nitsche interface, BDF1/BDF2,
-// Picard or Newton iterations, UMFPACK (sparse_lu.hpp) and consistent reaction forces. One
-// time-stepping, assembly, interface and checkpoint path for both elements:
+// Picard or Newton iterations, a linear-algebra engine (linear_solver.hpp: UMFPACK, PETSc,
+// MUMPS) and consistent reaction forces. One time-stepping, assembly, interface and checkpoint
+// path for both elements:
 //   "p1p1" - equal-order P1/P1 with SUPG/PSPG/LSIC (the seed paper's element; NavierStokesSolver)
 //   "p2p1" - isoparametric Taylor-Hood P2/P1 (inf-sup stable; optional SUPG, grad-div; TaylorHoodSolver)
 // whose element parts (local assembly, DOF layout, interface traces, output) sit behind one
@@ -85,6 +86,9 @@ enum class Ordering { Amd, Metis, Auto };
 // elements' saddle-point matrices (measured: 20 % faster factorisations, 30 % faster solves
 // than Auto on Taylor-Hood); Auto lets UMFPACK decide from the pattern.
 enum class LuStrategy { Auto, Symmetric, Unsymmetric };
+// The linear-algebra engine (linear_solver.hpp): UMFPACK (sparse_lu.hpp), a PETSc Krylov solver
+// (field-split preconditioner by default), or MUMPS through PETSc.
+enum class LinearEngine { Umfpack, Petsc, Mumps };
 
 struct FlowParameters {
   double density = 1.0;
@@ -123,6 +127,17 @@ struct FlowParameters {
   // current factors (their factorisation included): minimises the cost per step. Costs are
   // counted in flops, not measured, so the decisions are reproducible (sparse_lu.hpp).
   bool adaptive_refactorisation = true;
+  LinearEngine engine = LinearEngine::Umfpack;
+  // PETSc engines: options after the engine's defaults (default_petsc_options), e.g.
+  // "-ksp_rtol 1e-12 -fieldsplit_p_pc_type gamg"; an option the solver leaves unused is an error.
+  std::string petsc_options;
+  // PETSc engines: keep the preconditioner of an earlier matrix while the iterations stay below
+  // petsc_rebuild_factor x those of its first solve (+ 5) (and it converges); else rebuild.
+  bool petsc_reuse_preconditioner = true;
+  double petsc_rebuild_factor = 1.5;
+  // Tests only (the GCL tests' control): the ALE mesh velocity is multiplied by this; anything
+  // but 1 is a wrong mesh velocity, which a GCL test must detect.
+  double mesh_velocity_scale = 1.0;
 };
 
 struct StepReport {

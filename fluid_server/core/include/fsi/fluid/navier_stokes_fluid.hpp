@@ -68,7 +68,9 @@ class NavierStokesFluid : public FluidModel {
   // Cumulative seconds: "mesh_motion" (extension), "assembly", "factorisation", "linear_solve"
   // (triangular solves and Krylov iterations), "step" (all of them, per solve call).
   std::map<std::string, double> timings() const override {
-    std::map<std::string, double> t{{"mesh_motion", motion_ ? motion_->seconds() : 0.0},
+    std::map<std::string, double> t{{"mesh_motion", motion_    ? motion_->seconds()
+                                                    : motion3_ ? motion3_->seconds()
+                                                               : 0.0},
                                     {"assembly", assembly_seconds_},
                                     {"factorisation", factor_seconds_},
                                     {"linear_solve", linear_solve_seconds_},
@@ -102,7 +104,8 @@ class NavierStokesFluid : public FluidModel {
   std::vector<std::pair<std::string, Eigen::Vector3d>> pressure_probes3_;
   void configure3(const schema::Reader& section);
   void configure_mesh_motion3(const schema::Reader& iface);
-  Eigen::MatrixX3d positions3(const Eigen::VectorXd& interface_displacement) const;
+  Eigen::MatrixX3d positions3(const Eigen::VectorXd& interface_displacement);
+  std::unique_ptr<MeshMotion3> motion3_;
   std::map<std::string, double> probes3();
   std::unique_ptr<FlowSolver> solver_;
   FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
@@ -113,6 +116,7 @@ class NavierStokesFluid : public FluidModel {
   void configure_mesh_motion(const schema::Reader& section, const std::vector<std::string>& groups,
                              const std::vector<std::string>& fixed_groups);
   void configure_output(const schema::Reader& section, double density);
+  void configure_vtk(const schema::Reader& section);  // fluid.output.vtk_every (both dimensions)
   void build_mesh_motion();
   // Remeshing (fluid.remesh; remesh.hpp).
   struct RemeshSettings {
@@ -152,6 +156,7 @@ class NavierStokesFluid : public FluidModel {
   std::chrono::steady_clock::time_point start_, last_log_;
   int solves_ = 0;
   int factorisations_ = 0;                           // cumulative
+  int linear_iterations_ = 0;                        // cumulative Krylov iterations (3D probe)
   Eigen::VectorXd last_interface_displacement_;      // of the last solve (for the mesh motion's accept)
   Eigen::VectorXd accepted_interface_displacement_;  // of the last accepted step (a remesh's new offset)
   int retried_step_ = -1;                            // the step whose folding motion was remeshed and solved again

@@ -1,5 +1,5 @@
 #pragma once
-// The fluid's linear solve, shared by both discretisations: UMFPACK with one symbolic
+// The fluid's UMFPACK engine (linear_solver.hpp), shared by both discretisations: UMFPACK with one symbolic
 // analysis per sparsity pattern (METIS or AMD ordering), a numeric factorisation per matrix,
 // or - with reuse_factorisation - BiCGSTAB preconditioned by the factors of an earlier
 // matrix, refactorising only when that preconditioner has gone stale.
@@ -34,10 +34,11 @@
 
 #include "fsi/common/state.hpp"
 #include "fsi/fluid/flow_solver.hpp"
+#include "fsi/fluid/linear_solver.hpp"
 
 namespace fsi::fluid {
 
-class SparseLu {
+class SparseLu final : public LinearSolver {
  public:
   // Wall time per flop of the triangular solves and products of a Krylov solve over that of a
   // factorisation: 1.16-1.28e-9 s against 4.1-4.3e-10 s, measured on DFG 2D-2 P1/P1 (39k
@@ -45,8 +46,9 @@ class SparseLu {
   // accuracy; the same constant on every machine keeps them reproducible.
   static constexpr double kFactorFlopSpeedup = 3.0;
 
-  explicit SparseLu(const FlowParameters& params);
-  ~SparseLu();
+  // long_indices: UMFPACK's 64-bit API (umfpack_dl_*; the 3D fluid), else umfpack_di_*.
+  explicit SparseLu(const FlowParameters& params, bool long_indices = false);
+  ~SparseLu() override;
   SparseLu(SparseLu&&) noexcept;
   SparseLu& operator=(SparseLu&&) noexcept;
   // Adds its factorisation / solve times and counts to `report`. Throws fsi::SolverError
@@ -55,7 +57,7 @@ class SparseLu {
   // another coefficient of the time derivative (the first BDF2 step after the BDF1 start, a
   // new step size) are not reused.
   Eigen::VectorXd solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, const Eigen::VectorXd& guess,
-                        StepReport& report, const std::string& where, double time_coefficient = 0);
+                        StepReport& report, const std::string& where, double time_coefficient = 0) override;
   // The ordering in use (Ordering::Auto picks it at the first factorisation) and, for Auto,
   // UMFPACK's flop counts of the first factorisation with AMD and with METIS (0, 0 otherwise).
   Ordering ordering() const;
@@ -66,9 +68,9 @@ class SparseLu {
   // "amd", "metis", or "auto" before the first factorisation) and the auto trial's flop
   // counts; load_state() on a fresh SparseLu makes it use that ordering without a new trial
   // (fsi::StateError if the parameters fix a different one).
-  void discard_factors();
-  void save_state(StateArchive& state, const std::string& prefix) const;
-  void load_state(const StateArchive& state, const std::string& prefix);
+  void discard_factors() override;
+  void save_state(StateArchive& state, const std::string& prefix) const override;
+  void load_state(const StateArchive& state, const std::string& prefix) override;
 
  private:
   struct Impl;
