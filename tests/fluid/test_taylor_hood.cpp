@@ -292,6 +292,34 @@ TEST(TaylorHood, SolidBodyTranslationThroughNitscheIsExact) {
   }
 }
 
+TEST(TaylorHood, PressureInletDrivesExactPoiseuille) {
+  // fluid.pressures in 2D: the inlet x = 0 a normal traction -p_in n, the outlet do-nothing,
+  // no-slip walls: u = p_in y (H - y) / (2 mu L), p = p_in (1 - x / L), exact in P2/P1.
+  const double L = 2, H = 1, mu = 0.1, p_in = 0.6;
+  FlowParameters p;
+  p.viscosity = mu;
+  p.scheme = TimeScheme::Steady;
+  p.newton = true;
+  p.max_iterations = 8;
+  p.tolerance = 1e-12;
+  p.stabilisation.supg = false;
+  p.reuse_factorisation = false;
+  TaylorHoodSolver s(FluidMesh::rectangle(0, L, 0, H, 6, 3), p);
+  const auto zero = [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero().eval(); };
+  s.add_dirichlet("bottom", zero);
+  s.add_dirichlet("top", zero);
+  s.add_pressure("left", [&](double) { return p_in; });
+  s.solve(1, 1, s.mesh().nodes, {});
+  const auto v = s.velocity();
+  double err = 0;
+  for (int i = 0; i < s.mesh().node_count(); ++i) {
+    const double y = s.mesh().nodes(i, 1);
+    err = std::max(err, (v.row(i).transpose() - Eigen::Vector2d(p_in * y * (H - y) / (2 * mu * L), 0)).norm());
+  }
+  EXPECT_LT(err, 1e-10);
+  EXPECT_NEAR(s.pressure_at({0.3, 0.4}), p_in * (1 - 0.3 / L), 1e-10);
+}
+
 TEST(TaylorHood, BadlyCurvedElementIsReportedWithTimeAndPlace) {
   TaylorHoodSolver s(FluidMesh::rectangle(0, 1, 0, 1, 4, 4), FlowParameters{});
   s.add_dirichlet("bottom", [](const Eigen::Vector2d&, double) { return Eigen::Vector2d::Zero(); });

@@ -1,7 +1,8 @@
 // The 3D fluid: the tetrahedral quadrature and P2 shape functions, the tetrahedral mesh from
 // gmsh (and a 3D mesh refused by the 2D fluid), and the 3D FlowSolver (Taylor-Hood on
 // tetrahedra) reproducing plane Poiseuille flow exactly (a quadratic velocity, a linear
-// pressure: in the P2/P1 space) with Newton, and refusing an interface.
+// pressure: in the P2/P1 space) with Newton, also with a Nitsche interface (the coupling
+// interface of the 3D fluid: its faces, its mass and its tractions).
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -121,7 +122,6 @@ TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
   solver.add_dirichlet("top", exact);
   solver.add_symmetry("back");
   solver.add_symmetry("front");
-  EXPECT_THROW(solver.set_interface({"top"}), std::invalid_argument);
   const auto report = solver.solve(1, 1, solver.mesh().nodes, {});
   EXPECT_LT(report.change, 1e-12);
   const auto v = solver.velocity();
@@ -218,6 +218,130 @@ TEST(FlowSolver3, PetscRefusesAnUnknownOptionNamingIt) {
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("no_such_krylov"), std::string::npos) << e.what();
   }
+}
+
+// A box whose whole boundary is the Nitsche interface, moving with a uniform velocity V: the
+// flow u = V, p = 0 solves Navier-Stokes and the Nitsche conditions exactly; the interface is
+// the box's faces (6-node triangles), its mass sums to the box's area and the traction is 0.
+TEST(FlowSolver3Nitsche, TranslationOfTheWholeBoxIsExact) {
+  const Eigen::Vector3d V(0.3, -0.2, 0.5);
+  TetMesh mesh = TetMesh::box({0, 0, 0}, {1, 0.8, 0.6}, 2, 2, 2);
+  FlowParameters params;
+  params.viscosity = 0.05;
+  params.scheme = TimeScheme::Steady;
+  params.newton = true;
+  params.max_iterations = 8;
+  params.tolerance = 1e-12;
+  params.stabilisation.supg = false;
+  params.reuse_factorisation = false;
+  params.nitsche_penalty = 100;
+  FlowSolver3 solver(mesh, params, "p2p1");
+  solver.set_interface({"left", "right", "bottom", "top", "back", "front"});
+  solver.set_pressure_reference({0.5, 0.4, 0.3}, [](double) { return 0.0; });
+  // 2 x 2 x 2 cells: 8 triangles on each of the six sides.
+  ASSERT_EQ(solver.interface_faces().size(), 48u);
+  EXPECT_EQ(solver.interface_nodes().size(), static_cast<std::size_t>(5 * 5 * 5 - 3 * 3 * 3));
+  const auto n = static_cast<Eigen::Index>(solver.interface_nodes().size());
+  Eigen::VectorXd vs(3 * n);
+  for (Eigen::Index i = 0; i < n; ++i) vs.segment<3>(3 * i) = V;
+  const auto report = solver.solve(1, 1, solver.mesh().nodes, vs);
+  EXPECT_LT(report.change, 1e-12);
+  const auto v = solver.velocity();
+  double err = 0;
+  for (int i = 0; i < solver.mesh().node_count(); ++i) err = std::max(err, (v.row(i).transpose() - V).norm());
+  EXPECT_LT(err, 1e-11);
+  EXPECT_NEAR(solver.pressure_at({0.2, 0.7, 0.1}), 0, 1e-10);
+  EXPECT_NEAR(solver.interface_mass().sum(), 2 * (0.8 + 0.48 + 0.6), 1e-12);
+  EXPECT_LT(solver.interface_traction().cwiseAbs().maxCoeff(), 1e-10);
+}
+
+// Plane Poiseuille flow as above with the bottom wall a Nitsche interface at rest (v_s = 0):
+// still exact, and the traction on the interface is the wall shear tau = 4 mu U / H against
+// the flow, node by node -tau times the node's row sum of the interface mass (away from the
+// inlet, whose strongly held nodes carry the inlet pressure too; in z away from the symmetry
+// planes, whose nodes carry their reaction).
+TEST(FlowSolver3Nitsche, PoiseuilleWithNitscheInletAndWallsIsExactAndItsTractionIsTheShear) {
+  const double L = 2, H = 1, U = 1.5, mu = 0.1, W = 0.5;
+  TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, W}, 4, 2, 1);
+  FlowParameters params;
+  params.viscosity = mu;
+  params.scheme = TimeScheme::Steady;
+  params.newton = true;
+  params.max_iterations = 8;
+  params.tolerance = 1e-12;
+  params.stabilisation.supg = false;
+  params.reuse_factorisation = false;
+  params.nitsche_penalty = 50;
+  FlowSolver3 solver(mesh, params, "p2p1");
+  auto exact = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
+    return {4 * U * x.y() * (H - x.y()) / (H * H), 0, 0};
+  };
+  solver.add_dirichlet("left", exact);
+  solver.add_dirichlet("top", exact);
+  solver.add_symmetry("back");
+  solver.add_symmetry("front");
+  solver.set_interface({"bottom"});
+  ASSERT_EQ(solver.interface_faces().size(), 8u);
+  const auto report = solver.solve(1, 1, solver.mesh().nodes, {});
+  EXPECT_LT(report.change, 1e-12);
+  const auto v = solver.velocity();
+  double err = 0;
+  for (int i = 0; i < solver.mesh().node_count(); ++i)
+    err = std::max(err, (v.row(i).transpose() - exact(solver.mesh().nodes.row(i).transpose(), 0)).norm());
+  EXPECT_LT(err, 1e-10);
+  EXPECT_NEAR(solver.pressure_at({0.3, 0.4, 0.2}), 8 * mu * U * (L - 0.3) / (H * H), 1e-9);
+  const double tau = 4 * mu * U / H;
+  const Eigen::SparseMatrix<double> M = solver.interface_mass();
+  const Eigen::VectorXd row_sums = M * Eigen::VectorXd::Ones(M.cols());
+  EXPECT_NEAR(row_sums.sum(), L * W, 1e-12);
+  const Eigen::VectorXd f = solver.interface_traction();
+  const auto& nodes = solver.interface_nodes();
+  int checked = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (solver.mesh().nodes(nodes[i], 0) < 1e-12) continue;  // on the inlet
+    const auto k = static_cast<Eigen::Index>(i);
+    EXPECT_NEAR(f(3 * k), -tau * row_sums(k), 1e-9) << "node " << nodes[i];
+    const double z = solver.mesh().nodes(nodes[i], 2);
+    if (z > 1e-12 && z < W - 1e-12) {
+      EXPECT_NEAR(f(3 * k + 2), 0, 1e-9);  // (the symmetry planes' reactions)
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 9 * 3 - 3);
+}
+
+// Pressure-driven plane Poiseuille flow: the inlet x = 0 a prescribed normal traction -p_in n,
+// the outlet do-nothing (p = 0), no-slip walls y = 0, H: u = p_in y (H - y) / (2 mu L),
+// p = p_in (1 - x / L), exactly in the P2/P1 space. The pressure reaches the flow only
+// through the traction: doubling p_in doubles the flow.
+TEST(FlowSolver3, PressureInletDrivesExactPoiseuille) {
+  const double L = 2, H = 1, mu = 0.1, p_in = 0.6;
+  TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1);
+  FlowParameters params;
+  params.viscosity = mu;
+  params.scheme = TimeScheme::Steady;
+  params.newton = true;
+  params.max_iterations = 8;
+  params.tolerance = 1e-12;
+  params.stabilisation.supg = false;
+  params.reuse_factorisation = false;
+  FlowSolver3 solver(mesh, params, "p2p1");
+  const auto zero = [](const Eigen::Vector3d&, double) { return Eigen::Vector3d::Zero().eval(); };
+  solver.add_dirichlet("bottom", zero);
+  solver.add_dirichlet("top", zero);
+  solver.add_symmetry("back");
+  solver.add_symmetry("front");
+  solver.add_pressure("left", [&](double) { return p_in; });
+  const auto report = solver.solve(1, 1, solver.mesh().nodes, {});
+  EXPECT_LT(report.change, 1e-12);
+  const auto v = solver.velocity();
+  double err = 0;
+  for (int i = 0; i < solver.mesh().node_count(); ++i) {
+    const double y = solver.mesh().nodes(i, 1);
+    err = std::max(err, (v.row(i).transpose() - Eigen::Vector3d(p_in * y * (H - y) / (2 * mu * L), 0, 0)).norm());
+  }
+  EXPECT_LT(err, 1e-10);
+  EXPECT_NEAR(solver.pressure_at({0.3, 0.4, 0.2}), p_in * (1 - 0.3 / L), 1e-10);
 }
 
 }  // namespace

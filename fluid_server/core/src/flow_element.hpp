@@ -18,6 +18,7 @@
 #include <array>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -55,13 +56,15 @@ struct LocalSystem {
   Eigen::VectorXd rhs;
 };
 
-// A boundary segment on the Nitsche interface: its triangle, the triangle's edge k (vertices
-// k, k + 1 mod 3) and the segment's nodes, as local node numbers of the triangle and as
-// interface indices (P1: the segment's two vertices in the group's order; P2: vertex k,
-// vertex k + 1, midpoint 3 + k).
+// A boundary segment (2D) or face (3D) on the Nitsche interface: its element and the
+// segment's or face's nodes, as local node numbers of the element and as interface indices.
+// 2D: the triangle's edge k (vertices k, k + 1 mod 3); P1: the segment's two vertices in the
+// group's order; P2: vertex k, vertex k + 1, midpoint 3 + k. 3D (10-node tetrahedra): `edge`
+// is the local vertex opposite the face; the face's vertices a, b, c in the group's order,
+// then the midpoints of ab, bc, ca.
 struct InterfaceEdge {
   int element = 0, edge = 0;
-  std::array<int, 3> local{}, iface{};
+  std::array<int, 6> local{}, iface{};
 };
 
 // What the Nitsche terms read.
@@ -105,6 +108,17 @@ class FlowElementT {
   // a mesh node to its interface index. Appends the edge's interface segments.
   virtual InterfaceEdge interface_edge(int e, int k, int a, int b, const std::map<int, int>& iface,
                                        std::vector<std::array<int, 2>>& segments) const = 0;
+  // 3D: the interface face (a, b, c) = abc of tetrahedron e, the vertex opposite it
+  // `opposite`; appends the face's interface nodes (gmsh order: a, b, c, ab, bc, ca).
+  virtual InterfaceEdge interface_face(int, int, const std::array<int, 3>&, const std::map<int, int>&,
+                                       std::vector<std::array<int, 6>>&) const {
+    throw std::invalid_argument(std::string("the element ") + name() + " has no interface faces");
+  }
+  // -p int N_i n over the edge or face (outward normal n at positions X): the load of a
+  // prescribed normal traction, in the element's local order (overwrites `load`).
+  virtual void pressure_load(const InterfaceEdge&, const NodeMatrix<Dim>&, double, Eigen::VectorXd&) const {
+    throw std::invalid_argument(std::string("the element ") + name() + " has no pressure boundaries");
+  }
   // The Nitsche terms of the edge (overwrites `out`), in the triangle's local order.
   virtual void nitsche(const InterfaceEdge& edge, const NitscheInput& in, LocalSystem& out) const = 0;
   // int N_i N_j over the edge at positions X, on the interface indices.
@@ -123,7 +137,7 @@ using FlowElement = FlowElementT<2>;
 std::unique_ptr<FlowElement> make_p1p1_element(FluidMesh mesh);
 std::unique_ptr<FlowElement> make_p2p1_element(FluidMesh mesh);
 // 3D: isoparametric Taylor-Hood P2/P1 on 10-node tetrahedra (flow_element_p2p1_tet.cpp; a
-// linear mesh gets straight midpoints). No Nitsche interface yet.
+// linear mesh gets straight midpoints).
 std::unique_ptr<FlowElementT<3>> make_p2p1_tet_element(TetMesh mesh);
 
 }  // namespace fsi::fluid::detail

@@ -9,6 +9,7 @@
 
 #include "flow_element.hpp"
 #include "fsi/fluid/p2p1_element.hpp"
+#include "nitsche_trace.hpp"
 
 namespace fsi::fluid::detail {
 namespace {
@@ -19,16 +20,10 @@ const Eigen::Vector2d kRefVertex[3] = {{0, 0}, {1, 0}, {0, 1}};
 constexpr double kGaussX[4] = {0.0694318442029737, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263};
 constexpr double kGaussW[4] = {0.1739274225687269, 0.3260725774312731, 0.3260725774312731, 0.1739274225687269};
 
+using EdgePoint = TracePoint<6, 2>;
+
 // Geometry at point s of edge k of an element: shape functions, physical gradients, the
 // length element and the outward normal.
-struct EdgePoint {
-  Eigen::Matrix<double, 6, 1> N;
-  Eigen::Matrix<double, 6, 2> G;
-  double ds = 0;
-  Eigen::Vector2d normal;
-  Eigen::Vector3d L;  // linear (pressure) shape functions
-};
-
 EdgePoint edge_point(const Eigen::Matrix<double, 6, 2>& x, int k, double s) {
   EdgePoint p;
   const Eigen::Vector2d d = kRefVertex[(k + 1) % 3] - kRefVertex[k];
@@ -42,34 +37,6 @@ EdgePoint edge_point(const Eigen::Matrix<double, 6, 2>& x, int k, double s) {
   p.normal = Eigen::Vector2d(t.y(), -t.x()) / p.ds;  // counter-clockwise element: outward
   p.L << 1 - r.x() - r.y(), r.x(), r.y();
   return p;
-}
-
-// The Nitsche terms of one Gauss point of an interface edge (p at the current positions, w
-// its weight, w_pen the penalty term's) added to the local system.
-void add_nitsche_point(const EdgePoint& p, double w, double w_pen, const Eigen::Matrix<double, 6, 2>& vs,
-                       const FlowParameters& params, LocalSystem& out) {
-  const double g1 = params.nitsche_penalty, g2 = params.nitsche_symmetry, mu = params.viscosity;
-  const bool step_start = params.penalty_on_step_start;
-  const Eigen::Matrix<double, 6, 1> gn = p.G * p.normal;
-  const Eigen::RowVector2d v = p.N.transpose() * vs;
-  for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) {
-      // (the default's arithmetic exactly as before the penalty_geometry option)
-      const double vel = step_start
-                             ? w_pen * g1 * p.N(i) * p.N(j) + w * (-mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j))
-                             : w * (g1 * p.N(i) * p.N(j) - mu * p.N(i) * gn(j) - g2 * mu * gn(i) * p.N(j));
-      for (int c = 0; c < 2; ++c) out.matrix(2 * i + c, 2 * j + c) += vel;
-    }
-    for (int j = 0; j < 3; ++j)
-      for (int c = 0; c < 2; ++c) {
-        out.matrix(2 * i + c, 12 + j) += w * p.N(i) * p.normal(c) * p.L(j);
-        out.matrix(12 + j, 2 * i + c) += w * g2 * p.L(j) * p.normal(c) * p.N(i);
-      }
-    for (int c = 0; c < 2; ++c)
-      out.rhs(2 * i + c) +=
-          step_start ? (w_pen * g1 * p.N(i) - w * g2 * mu * gn(i)) * v(c) : w * (g1 * p.N(i) - g2 * mu * gn(i)) * v(c);
-  }
-  for (int j = 0; j < 3; ++j) out.rhs(12 + j) += w * g2 * p.L(j) * v.dot(p.normal.transpose());
 }
 
 class P2P1Element final : public FlowElement {
@@ -165,6 +132,17 @@ class P2P1Element final : public FlowElement {
       const double w = kGaussW[g] * p.ds;
       const double w_pen = step_start ? kGaussW[g] * edge_point(x_pen, edge.edge, kGaussX[g]).ds : w;
       add_nitsche_point(p, w, w_pen, vs, in.params, out);
+    }
+  }
+
+  void pressure_load(const InterfaceEdge& edge, const Eigen::MatrixX2d& X, double p,
+                     Eigen::VectorXd& load) const override {
+    const auto x = element_positions(X, edge.element);
+    load.setZero(15);
+    for (int g = 0; g < 4; ++g) {
+      const auto q = edge_point(x, edge.edge, kGaussX[g]);
+      for (int i = 0; i < 6; ++i)
+        for (int c = 0; c < 2; ++c) load(2 * i + c) -= p * kGaussW[g] * q.ds * q.N(i) * q.normal(c);
     }
   }
 

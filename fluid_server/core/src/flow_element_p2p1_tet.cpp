@@ -1,15 +1,53 @@
 // The isoparametric Taylor-Hood P2/P1 element part of the 3D FlowSolver (flow_element.hpp):
 // 10-node tetrahedra, (u, v, w) of every node at 3 i .. 3 i + 2, then p of the vertices
-// (3 n + i). No Nitsche interface yet (FlowSolver3 refuses interface groups).
+// (3 n + i). P2 traces on the interface faces (6-node triangles), integrated with the 7-point
+// rule exact to degree 5 (fsi::face_quadrature).
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <stdexcept>
 
 #include "flow_element.hpp"
+#include "fsi/common/interface_geometry.hpp"
 #include "fsi/fluid/p2p1_tet_element.hpp"
+#include "nitsche_trace.hpp"
 
 namespace fsi::fluid::detail {
 namespace {
+
+const Eigen::Vector3d kRefVertex[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+using FacePoint = TracePoint<10, 3>;
+
+// The local node (4 .. 9) of the midpoint of the tetrahedron's edge between local vertices a, b.
+int midpoint_node(int a, int b) {
+  for (int k = 0; k < 6; ++k)
+    if ((kTetEdges[k][0] == a && kTetEdges[k][1] == b) || (kTetEdges[k][0] == b && kTetEdges[k][1] == a)) return 4 + k;
+  throw std::logic_error("not an edge of a tetrahedron");
+}
+
+// Geometry at the point (xi, eta) of the interface face (local vertices face.local[0..2],
+// xi along 0 -> 1, eta along 0 -> 2) of an element at positions x: shape functions, physical
+// gradients, the area element (per unit reference area) and the normal pointing away from the
+// vertex opposite the face (face.edge), i.e. out of the fluid.
+FacePoint face_point(const Eigen::Matrix<double, 10, 3>& x, const InterfaceEdge& face, double xi, double eta) {
+  FacePoint p;
+  const Eigen::Vector3d& r0 = kRefVertex[face.local[0]];
+  const Eigen::Vector3d d1 = kRefVertex[face.local[1]] - r0, d2 = kRefVertex[face.local[2]] - r0;
+  const Eigen::Vector3d r = r0 + xi * d1 + eta * d2;
+  Eigen::Matrix<double, 10, 3> dN;
+  p2_tet_shape(r.x(), r.y(), r.z(), p.N, dN);
+  const Eigen::Matrix3d J = x.transpose() * dN;
+  p.G = dN * J.inverse();
+  const Eigen::Vector3d t1 = J * d1, t2 = J * d2;
+  const Eigen::Vector3d n = t1.cross(t2);
+  p.ds = n.norm();
+  p.normal = n / p.ds;
+  const Eigen::Vector3d X = x.transpose() * p.N;
+  if (p.normal.dot(X - x.row(face.edge).transpose()) < 0) p.normal = -p.normal;
+  p.L << 1 - r.x() - r.y() - r.z(), r.x(), r.y(), r.z();
+  return p;
+}
 
 class P2P1TetElement final : public FlowElementT<3> {
  public:
@@ -74,13 +112,63 @@ class P2P1TetElement final : public FlowElementT<3> {
 
   InterfaceEdge interface_edge(int, int, int, int, const std::map<int, int>&,
                                std::vector<std::array<int, 2>>&) const override {
-    throw std::invalid_argument("the 3D fluid has no Nitsche interface yet");
+    throw std::logic_error("the 3D fluid's interface is made of faces");
   }
-  void nitsche(const InterfaceEdge&, const NitscheInput&, LocalSystem&) const override {
-    throw std::invalid_argument("the 3D fluid has no Nitsche interface yet");
+  InterfaceEdge interface_face(int e, int opposite, const std::array<int, 3>& abc, const std::map<int, int>& iface,
+                               std::vector<std::array<int, 6>>& faces) const override {
+    InterfaceEdge face{};
+    face.element = e;
+    face.edge = opposite;
+    for (std::size_t j = 0; j < 3; ++j)
+      for (int k = 0; k < 4; ++k)
+        if (mesh_.tets(e, k) == abc[j]) face.local[j] = k;
+    for (std::size_t j = 0; j < 3; ++j) face.local[3 + j] = midpoint_node(face.local[j], face.local[(j + 1) % 3]);
+    const auto nodes = mesh_.element_nodes10(e);
+    for (std::size_t j = 0; j < 6; ++j) face.iface[j] = iface.at(nodes(face.local[j]));
+    faces.push_back(face.iface);
+    return face;
   }
-  void interface_mass(const InterfaceEdge&, const NodeMatrix<3>&, std::vector<Eigen::Triplet<double>>&) const override {
-    throw std::invalid_argument("the 3D fluid has no Nitsche interface yet");
+
+  // The seed paper's fluid weak form with P2 traces on the face.
+  void nitsche(const InterfaceEdge& face, const NitscheInput& in, LocalSystem& out) const override {
+    const auto x = element_positions(in.X, face.element);
+    Eigen::Matrix<double, 10, 3> vs = Eigen::Matrix<double, 10, 3>::Zero();
+    for (std::size_t j = 0; j < 6; ++j) vs.row(face.local[j]) = in.v_s.segment<3>(3 * face.iface[j]).transpose();
+    out.matrix.setZero(34, 34);
+    out.rhs.setZero(34);
+    const bool step_start = in.params.penalty_on_step_start;
+    const auto x_pen = step_start ? element_positions(in.X_n, face.element) : x;
+    for (const auto& q : fsi::face_quadrature(6)) {
+      const auto p = face_point(x, face, q.xi, q.eta);
+      const double w = q.weight * p.ds;
+      const double w_pen = step_start ? q.weight * face_point(x_pen, face, q.xi, q.eta).ds : w;
+      add_nitsche_point(p, w, w_pen, vs, in.params, out);
+    }
+  }
+  void pressure_load(const InterfaceEdge& face, const NodeMatrix<3>& X, double p,
+                     Eigen::VectorXd& load) const override {
+    const auto x = element_positions(X, face.element);
+    load.setZero(34);
+    for (const auto& q : fsi::face_quadrature(6)) {
+      const auto fp = face_point(x, face, q.xi, q.eta);
+      for (int i = 0; i < 10; ++i)
+        for (int c = 0; c < 3; ++c) load(3 * i + c) -= p * q.weight * fp.ds * fp.N(i) * fp.normal(c);
+    }
+  }
+  void interface_mass(const InterfaceEdge& face, const NodeMatrix<3>& X,
+                      std::vector<Eigen::Triplet<double>>& t) const override {
+    const auto x = element_positions(X, face.element);
+    Eigen::Matrix<double, 6, 6> m = Eigen::Matrix<double, 6, 6>::Zero();
+    for (const auto& q : fsi::face_quadrature(6)) {
+      const auto p = face_point(x, face, q.xi, q.eta);
+      for (std::size_t i = 0; i < 6; ++i)
+        for (std::size_t j = 0; j < 6; ++j)
+          m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) +=
+              q.weight * p.ds * p.N(face.local[i]) * p.N(face.local[j]);
+    }
+    for (std::size_t i = 0; i < 6; ++i)
+      for (std::size_t j = 0; j < 6; ++j)
+        t.emplace_back(face.iface[i], face.iface[j], m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)));
   }
 
   Eigen::VectorXd nodal_pressure(const Eigen::VectorXd& U) const override {

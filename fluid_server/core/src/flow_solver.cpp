@@ -7,6 +7,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -180,12 +181,20 @@ struct BasicFlowSolver<Dim>::Impl {
   std::vector<DirichletCondition<Dim>> dirichlet;
   std::vector<SymmetryCondition> symmetry;
   std::vector<detail::InterfaceEdge> edges;
+  struct PressureCondition {
+    std::vector<detail::InterfaceEdge> traces;
+    std::function<double(double)> pressure;
+  };
+  std::vector<PressureCondition> pressures;  // normal tractions -p n (add_pressure)
   int pressure_vertex = -1;
   std::function<double(double)> pressure_value;
   Velocity body_force;
   std::vector<std::vector<double>> thread_values;
 
   const Mesh& mesh() const { return element->mesh(); }
+  std::vector<detail::InterfaceEdge> traces(const std::vector<std::string>& groups, const std::map<int, int>& index,
+                                            std::vector<std::array<int, 2>>& segments,
+                                            std::vector<std::array<int, 6>>& faces) const;
   const int* dofs_of(int e) const {
     return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)];
   }
@@ -353,25 +362,47 @@ void BasicFlowSolver<Dim>::add_symmetry(const std::string& group) {
   impl_->symmetry.push_back({mesh().boundary_nodes({group}), symmetry_component(mesh(), group)});
 }
 
+// The element traces (edges in 2D, faces in 3D) of the boundary groups, with the nodes indexed
+// by `index`; their interface segments (2D) or faces (3D) appended to `segments` / `faces`.
 template <int Dim>
-void BasicFlowSolver<Dim>::set_interface(const std::vector<std::string>& groups) {
+std::vector<detail::InterfaceEdge> BasicFlowSolver<Dim>::Impl::traces(const std::vector<std::string>& groups,
+                                                                      const std::map<int, int>& index,
+                                                                      std::vector<std::array<int, 2>>& segments,
+                                                                      std::vector<std::array<int, 6>>& faces) const {
+  const auto& m = mesh();
+  std::vector<detail::InterfaceEdge> out;
   if constexpr (Dim == 3) {
-    if (!groups.empty()) throw std::invalid_argument("the 3D fluid has no Nitsche interface yet");
-    interface_velocity_.resize(0);
-    return;
+    (void)segments;
+    std::map<std::array<int, 3>, std::pair<int, int>> face_owner;  // sorted vertex triple -> (tetrahedron, opposite)
+    for (int e = 0; e < m.cell_count(); ++e)
+      for (int o = 0; o < 4; ++o) {
+        std::array<int, 3> f{};
+        for (int k = 0, j = 0; k < 4; ++k)
+          if (k != o) f[static_cast<std::size_t>(j++)] = m.tets(e, k);
+        std::sort(f.begin(), f.end());
+        face_owner[f] = {e, o};
+      }
+    for (const auto& name : groups) {
+      const auto& group = m.boundary(name);
+      for (Eigen::Index s = 0; s < group.rows(); ++s) {
+        const std::array<int, 3> abc{group(s, 0), group(s, 1), group(s, 2)};
+        auto key = abc;
+        std::sort(key.begin(), key.end());
+        const auto it = face_owner.find(key);
+        if (it == face_owner.end())
+          throw std::runtime_error(fmt::format("boundary group '{}': face ({}, {}, {}) is not a tetrahedron's face",
+                                               name, abc[0], abc[1], abc[2]));
+        out.push_back(element->interface_face(it->second.first, it->second.second, abc, index, faces));
+      }
+    }
   } else {
-    const auto& m = mesh();
-    interface_nodes_ = m.boundary_nodes(groups);
-    std::map<int, int> local;
-    for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
+    (void)faces;
     std::map<std::pair<int, int>, std::pair<int, int>> edge_owner;  // vertex pair -> (triangle, edge)
     for (int e = 0; e < m.triangle_count(); ++e)
       for (int k = 0; k < 3; ++k) {
         const int a = m.triangles(e, k), b = m.triangles(e, (k + 1) % 3);
         edge_owner[{std::min(a, b), std::max(a, b)}] = {e, k};
       }
-    impl_->edges.clear();
-    std::vector<std::array<int, 2>> segs;
     for (const auto& name : groups) {
       const auto& seg = m.boundary(name);
       for (Eigen::Index s = 0; s < seg.rows(); ++s) {
@@ -380,14 +411,36 @@ void BasicFlowSolver<Dim>::set_interface(const std::vector<std::string>& groups)
         if (it == edge_owner.end())
           throw std::runtime_error(
               fmt::format("interface group '{}': segment ({}, {}) is not a triangle edge", name, a, b));
-        impl_->edges.push_back(impl_->element->interface_edge(it->second.first, it->second.second, a, b, local, segs));
+        out.push_back(element->interface_edge(it->second.first, it->second.second, a, b, index, segments));
       }
     }
+  }
+  return out;
+}
+
+template <int Dim>
+void BasicFlowSolver<Dim>::set_interface(const std::vector<std::string>& groups) {
+  interface_nodes_ = mesh().boundary_nodes(groups);
+  std::map<int, int> local;
+  for (std::size_t i = 0; i < interface_nodes_.size(); ++i) local[interface_nodes_[i]] = static_cast<int>(i);
+  std::vector<std::array<int, 2>> segs;
+  interface_faces_.clear();
+  impl_->edges = impl_->traces(groups, local, segs, interface_faces_);
+  if constexpr (Dim == 2) {
     interface_segments_.resize(static_cast<Eigen::Index>(segs.size()), 2);
     for (std::size_t s = 0; s < segs.size(); ++s)
       interface_segments_.row(static_cast<Eigen::Index>(s)) << segs[s][0], segs[s][1];
-    interface_velocity_ = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(interface_nodes_.size()));
   }
+  interface_velocity_ = Eigen::VectorXd::Zero(Dim * static_cast<Eigen::Index>(interface_nodes_.size()));
+}
+
+template <int Dim>
+void BasicFlowSolver<Dim>::add_pressure(const std::string& group, std::function<double(double)> pressure) {
+  std::map<int, int> index;
+  for (int node : mesh().boundary_nodes({group})) index[node] = static_cast<int>(index.size());
+  std::vector<std::array<int, 2>> segs;
+  std::vector<std::array<int, 6>> faces;
+  impl_->pressures.push_back({impl_->traces({group}, index, segs, faces), std::move(pressure)});
 }
 
 template <int Dim>
@@ -481,6 +534,18 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
       throw MeshTangled(fmt::format("fluid step at t = {:.6g}: {} {} near ({:.5g}, {:.5g}, {:.5g}) is {}", step.time,
                                     im.element->cell_name(), e, centre(0), centre(1), centre(2),
                                     im.element->inverted(bad)));
+    }
+  }
+  // Prescribed normal tractions -p n: loads of the volume residual (the reactions of nodes shared
+  // with the interface or a wall then hold only their own boundary's traction).
+  for (const auto& c : im.pressures) {
+    const double p = c.pressure(step.time);
+    if (p == 0) continue;
+    Eigen::VectorXd load;
+    for (const auto& t : c.traces) {
+      im.element->pressure_load(t, X_, p, load);
+      const int* d = im.dofs_of(t.element);
+      for (Eigen::Index i = 0; i < load.size(); ++i) im.rhs_volume(d[i]) += load(i);
     }
   }
   std::copy(im.volume.valuePtr(), im.volume.valuePtr() + im.volume.nonZeros(), im.matrix.valuePtr());

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -230,6 +231,48 @@ std::vector<std::string> read_nitsche(const schema::Reader& section, const Fluid
   return groups;
 }
 
+// The interface the coupler sees: the solver's interface nodes at their reference positions,
+// with its segments (2D) or 6-node faces (3D).
+template <int Dim>
+InterfaceMeshData interface_of(const BasicFlowSolver<Dim>& solver) {
+  InterfaceMeshData data;
+  const auto& nodes = solver.interface_nodes();
+  if (nodes.empty()) return data;  // a fluid alone
+  data.dimension = Dim;
+  data.coordinates.resize(static_cast<Eigen::Index>(nodes.size()), Dim);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    data.node_ids.push_back(nodes[i]);
+    data.coordinates.row(static_cast<Eigen::Index>(i)) = solver.mesh().nodes.row(nodes[i]);
+  }
+  if constexpr (Dim == 3) {
+    for (const auto& f : solver.interface_faces()) data.faces.push_back({std::vector<int>(f.begin(), f.end())});
+  } else {
+    const auto& seg = solver.interface_segments();
+    for (Eigen::Index s = 0; s < seg.rows(); ++s) data.segments.push_back({seg(s, 0), seg(s, 1)});
+  }
+  return data;
+}
+
+// The loads of the last solve (f_sigma, f_v, M_f) on the interface.
+template <int Dim>
+FluidLoads loads_of(const BasicFlowSolver<Dim>& solver) {
+  FluidLoads loads;
+  loads.traction_force = solver.interface_traction();
+  loads.velocity_integral = solver.interface_velocity_integral();
+  loads.interface_mass = solver.interface_mass();
+  return loads;
+}
+
+// A fluid.pressures entry: p from start_time to end_time (inclusive), 0 outside.
+std::function<double(double)> pressure_function(const schema::Reader& entry) {
+  const double p = entry.get<double>("pressure"), start = entry.get<double>("start_time");
+  const double end = entry.get_or<double>("end_time", std::numeric_limits<double>::infinity());
+  if (!(end >= start)) entry.fail("end_time", "end_time must not be before start_time");
+  // (with a margin of round-off: t_n = n dt summed may land a hair after a step's end time)
+  const double eps = 1e-9 * (std::abs(end) < 1e300 ? std::max(std::abs(end), 1e-6) : 0.0);
+  return [=](double t) { return t >= start - eps && t <= end + eps ? p : 0.0; };
+}
+
 const char* scheme_name(TimeScheme scheme) {
   return scheme == TimeScheme::Steady ? "steady" : scheme == TimeScheme::BDF1 ? "bdf1" : "bdf2";
 }
@@ -365,7 +408,6 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
 // (DFG 3D: 16 U y z (H - y)(H - z) / H^4); walls; outlets; symmetry planes; force and pressure probes.
 void NavierStokesFluid::configure3(const schema::Reader& section) {
   if (element_ != "p2p1") section.fail("element", "the 3D fluid is Taylor-Hood: set fluid.element: p2p1");
-  if (section.has("interface")) section.fail("dimension", "the 3D fluid runs alone (no coupling interface yet)");
   const auto mesh_section = section.child("mesh");
   const auto msh = mesh_file(mesh_section, 2, 3);
   TetMesh mesh;
@@ -379,6 +421,7 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
   read_stabilisation(section, true, params.stabilisation);
   if (params.stabilisation.supg) section.fail("stabilisation", "the 3D fluid has no SUPG (grad-div only)");
   read_linear_solver(section, true, 3, params);
+  const auto interface_groups = read_nitsche(section, setup_, params);
   solver3_ = std::make_unique<FlowSolver3>(std::move(mesh), params, element_);
   const auto& m = solver3_->mesh();
   auto vec3 = [](const std::vector<double>& v, const schema::Reader& where, const std::string& key) {
@@ -422,6 +465,25 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
   for (const auto& g : string_list(section, "outlet"))
     if (!m.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh.string());
   if (section.list("moving_walls").size() > 0) section.fail("moving_walls", "not in 3D yet");
+  for (const auto& entry : section.list("pressures")) {
+    const auto g = entry.get<std::string>("group");
+    if (!m.has_boundary(g)) entry.fail("group", "no boundary group '" + g + "' in " + msh.string());
+    solver3_->add_pressure(g, pressure_function(entry));
+  }
+  if (!interface_groups.empty()) {
+    const auto iface = section.child("interface");
+    for (const auto& g : interface_groups)
+      if (!m.has_boundary(g)) iface.fail("groups", "no boundary group '" + g + "' in " + msh.string());
+    interface_groups_ = interface_groups;
+    solver3_->set_interface(interface_groups);
+    std::vector<std::string> fixed;
+    for (const auto& inflow : section.list("inflow")) fixed.push_back(inflow.get<std::string>("group"));
+    for (const char* key : {"walls", "symmetry", "outlet"})
+      for (const auto& g : string_list(section, key)) fixed.push_back(g);
+    for (const auto& entry : section.list("pressures")) fixed.push_back(entry.get<std::string>("group"));
+    fixed_groups_ = fixed;
+    configure_mesh_motion3(iface);
+  }
   if (auto pr = section.optional_child("pressure_reference"))
     solver3_->set_pressure_reference(vec3(pr->get<std::vector<double>>("point"), *pr, "point"),
                                      [v = pr->get<double>("value")](double) { return v; });
@@ -455,8 +517,9 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
       pressure_differences_.push_back({k, {pair[0], pair[1]}});
     }
   fsi::logger("fluid")->info(
-      "fluid: 3D p2p1 (Taylor-Hood), {} nodes, {} tetrahedra, {} unknowns, scheme {}, {}, mesh {}", m.node_count(),
-      m.cell_count(), solver3_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard", msh.string());
+      "fluid: 3D p2p1 (Taylor-Hood), {} nodes, {} tetrahedra, {} unknowns, scheme {}, {}, {} interface nodes, mesh {}",
+      m.node_count(), m.cell_count(), solver3_->dofs(), scheme_name(params.scheme), params.newton ? "newton" : "picard",
+      solver3_->interface_nodes().size(), msh.string());
   configure_vtk(section);
   start_ = last_log_ = std::chrono::steady_clock::now();
 }
@@ -478,6 +541,11 @@ std::map<std::string, double> NavierStokesFluid::probes3() {
   for (const auto& [name, pair] : pressure_differences_) probes[name] = probes.at(pair.first) - probes.at(pair.second);
   probes["nonlinear_iterations"] = last_report_.iterations;
   probes["nonlinear_change"] = last_report_.change;
+  if (motion3_) {  // the moving mesh's quality (fsi/fluid/mesh_quality.hpp)
+    const TetMeshQuality q = mesh_quality(solver3_->mesh(), solver3_->accepted_positions());
+    probes["mesh_min_scaled_jacobian"] = q.min_scaled_jacobian;
+    probes["mesh_min_curved_jacobian"] = q.min_curved_jacobian;
+  }
   probes["factorisations"] = factorisations_;
   probes["linear_iterations"] = linear_iterations_;  // Krylov iterations so far (3D only: 2D outputs unchanged)
   return probes;
@@ -500,6 +568,9 @@ std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema
     }
     void set_pressure_reference(const Eigen::Vector2d& p, std::function<double(double)> v) {
       self.conditions_.push_back([p, v](FlowSolver& s) { s.set_pressure_reference(p, v); });
+    }
+    void add_pressure(const std::string& g, std::function<double(double)> p) {
+      self.conditions_.push_back([g, p](FlowSolver& s) { s.add_pressure(g, p); });
     }
   } solver{*this};
   conditions_.clear();
@@ -528,6 +599,13 @@ std::vector<std::string> NavierStokesFluid::add_boundary_conditions(const schema
   }
   for (const auto& g : string_list(section, "outlet")) {
     if (!mesh.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh);
+    fixed.push_back(g);
+  }
+  for (const auto& entry : section.list("pressures")) {
+    const auto g = entry.get<std::string>("group");
+    if (!mesh.has_boundary(g)) entry.fail("group", "no boundary group '" + g + "' in " + msh);
+    if (element_ != "p2p1") entry.fail("group", "pressure boundaries need fluid.element: p2p1");
+    solver.add_pressure(g, pressure_function(entry));
     fixed.push_back(g);
   }
   if (auto pr = section.optional_child("pressure_reference"))
@@ -847,27 +925,34 @@ Eigen::MatrixX2d NavierStokesFluid::extend(const Eigen::VectorXd& interface_disp
   return out;
 }
 
+// 3D: the mesh motion of the interface (fluid.interface's mesh_motion keys): MeshMotion3 on the
+// 10-node tetrahedra (extended on the vertices; interface midpoints follow the interface,
+// interior ones the mean of their edge), the groups with conditions held fixed.
+void NavierStokesFluid::configure_mesh_motion3(const schema::Reader& iface) {
+  MeshMotionOptions& motion = motion_options_;
+  motion.stiffening = iface.get<double>("mesh_stiffening");
+  if (iface.get<std::string>("mesh_motion") == "elastic") motion.method = MeshMotionOptions::Method::Elastic;
+  motion.incremental = iface.get<bool>("mesh_incremental");
+  if (iface.get<std::string>("mesh_motion_nodes") != "vertices")
+    iface.fail("mesh_motion_nodes", "the 3D fluid extends the displacement on the vertices only");
+  const auto& mesh = solver3_->mesh();
+  motion3_ = std::make_unique<MeshMotion3>(mesh, solver3_->interface_nodes(), mesh.boundary_nodes(fixed_groups_),
+                                           motion_options_);  // keeps a pointer to the solver's mesh
+}
+
+// 3D: every node's position for the interface displacement (3 per interface node).
+Eigen::MatrixX3d NavierStokesFluid::positions3(const Eigen::VectorXd& interface_displacement) {
+  if (!motion3_ || interface_displacement.size() == 0) return solver3_->mesh().nodes;
+  last_interface_displacement_ = interface_displacement;
+  return motion3_->positions(interface_displacement);
+}
+
 InterfaceMeshData NavierStokesFluid::interface() const {
-  InterfaceMeshData data;
-  if (solver3_) return data;
-  const auto& nodes = solver_->interface_nodes();
-  data.coordinates.resize(static_cast<Eigen::Index>(nodes.size()), 2);
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    data.node_ids.push_back(nodes[i]);
-    data.coordinates.row(static_cast<Eigen::Index>(i)) = solver_->mesh().nodes.row(nodes[i]);
-  }
-  const auto& seg = solver_->interface_segments();
-  for (Eigen::Index s = 0; s < seg.rows(); ++s) data.segments.push_back({seg(s, 0), seg(s, 1)});
-  return data;
+  return solver3_ ? interface_of(*solver3_) : interface_of(*solver_);
 }
 
 FluidLoads NavierStokesFluid::initial_loads(const Eigen::VectorXd&, const Eigen::VectorXd&) {
-  FluidLoads loads;
-  if (solver3_) return loads;
-  loads.traction_force = solver_->interface_traction();
-  loads.velocity_integral = solver_->interface_velocity_integral();
-  loads.interface_mass = solver_->interface_mass();
-  return loads;
+  return solver3_ ? loads_of(*solver3_) : loads_of(*solver_);
 }
 
 // One solve on the current mesh, moved by the interface displacement (after a remesh measured
@@ -894,7 +979,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   };
   if (solver3_) {
     try {
-      last_report_ = solver3_->solve(info.time, info.dt, solver3_->mesh().nodes, {});
+      last_report_ = solver3_->solve(info.time, info.dt, positions3(interface_displacement), interface_velocity);
     } catch (const SolverError& e) {
       throw SolverError(where(e));
     }
@@ -905,7 +990,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
     assembly_seconds_ += last_report_.assembly_seconds;
     factor_seconds_ += last_report_.factor_seconds;
     linear_solve_seconds_ += last_report_.solve_seconds;
-    FluidLoads loads;
+    FluidLoads loads = loads_of(*solver3_);
     loads.nonlinear_iterations = last_report_.iterations;
     return loads;
   }
@@ -933,10 +1018,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   }
   solve_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ++solves_;
-  FluidLoads loads;
-  loads.traction_force = solver_->interface_traction();
-  loads.velocity_integral = solver_->interface_velocity_integral();
-  loads.interface_mass = solver_->interface_mass();
+  FluidLoads loads = loads_of(*solver_);
   loads.nonlinear_iterations = last_report_.iterations;
   factorisations_ += last_report_.factorisations;
   assembly_seconds_ += last_report_.assembly_seconds;
@@ -954,6 +1036,8 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
   if (solver3_) {
     solver3_->accept();
+    if (motion3_ && last_interface_displacement_.size() > 0) motion3_->accept(last_interface_displacement_);
+    accepted_interface_displacement_ = last_interface_displacement_;
     return probes3();
   }
   solver_->accept();
@@ -1023,7 +1107,12 @@ std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& inf
 }
 
 void NavierStokesFluid::save_state(StateArchive& state) {
-  if (solver3_) return solver3_->save_state(state, "flow.");
+  if (solver3_) {
+    solver3_->save_state(state, "flow.");
+    if (motion3_) motion3_->save_state(state, "mesh.");
+    state.put("fluid.last_interface_displacement", last_interface_displacement_);
+    return;
+  }
   if (!solver_) throw std::logic_error("NavierStokesFluid::save_state before configure()");
   solver_->save_state(state, "flow.");
   if (motion_) motion_->save_state(state, "mesh.");
@@ -1034,7 +1123,24 @@ void NavierStokesFluid::save_state(StateArchive& state) {
 }
 
 void NavierStokesFluid::load_state(const StateArchive& state) {
-  if (solver3_) return solver3_->load_state(state, "flow.");
+  if (solver3_) {
+    if (!motion3_ && state.has("mesh.base_displacement"))
+      throw StateError(
+          "entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
+    const Eigen::VectorXd last = state.has("fluid.last_interface_displacement")
+                                     ? state.vector("fluid.last_interface_displacement")
+                                     : Eigen::VectorXd();
+    const auto interface_size = 3 * static_cast<Eigen::Index>(solver3_->interface_nodes().size());
+    if (last.size() != 0 && last.size() != interface_size)
+      throw StateError(
+          fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration "
+                      "needs {} (a different mesh or scene?)",
+                      last.size(), interface_size));
+    solver3_->load_state(state, "flow.");
+    if (motion3_) motion3_->load_state(state, "mesh.");
+    last_interface_displacement_ = accepted_interface_displacement_ = last;
+    return;
+  }
   if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
   if (const auto saved = state.text("flow.element"); saved != element_)
     throw StateError(

@@ -10,8 +10,8 @@ const std::vector<schema::Key>& navier_stokes_keys() {
   static const std::vector<Key> keys = {
       choice("element", {"p1p1", "p2p1"}, "P1/P1 with SUPG/PSPG, or isoparametric Taylor-Hood P2/P1").def("p1p1"),
       choice("dimension", {"2", "3"},
-             "2: triangles; 3: tetrahedra (p2p1, steady or BDF, fluid alone: no interface yet; points and "
-             "directions [x, y, z])")
+             "2: triangles; 3: tetrahedra (p2p1, steady or BDF; points and directions [x, y, z]; interface "
+             "faces of 6-node triangles)")
           .def("2"),
       section("mesh", "the fluid mesh: a gmsh .msh file, or a .geo meshed by gmsh (cached)",
               {
@@ -170,6 +170,16 @@ const std::vector<schema::Key>& navier_stokes_keys() {
           .def("[]"),
       string_list("symmetry", "symmetry (slip) boundary groups").def("[]"),
       string_list("outlet", "do-nothing outlets").def("[]"),
+      section_list("pressures",
+                   "pressure inlets/outlets: the normal traction (mu grad u - p I) n = -p n (p2p1), p from "
+                   "start_time to end_time, 0 outside",
+                   {
+                       text("group", "boundary group").req(),
+                       number("pressure", "p").req().in_unit("Pa"),
+                       number("start_time", "applied from").def("0").in_unit("s"),
+                       number("end_time", "applied until (default: always)").in_unit("s"),
+                   })
+          .def("[]"),
       section("pressure_reference", "pins the pressure at a point",
               {
                   vector2("point", "where").req().in_unit("m"),

@@ -22,6 +22,7 @@
 // per step is the second-order semi-implicit scheme (one factorisation per step).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -165,8 +166,11 @@ class BasicFlowSolver {
   BasicFlowSolver& operator=(BasicFlowSolver&&) noexcept;
 
   // --- set-up (before the first solve) ---
-  void add_dirichlet(const std::string& group, Velocity velocity);                        // strong, both components
-  void add_symmetry(const std::string& group);                                            // u.n = 0 (axis-aligned)
+  void add_dirichlet(const std::string& group, Velocity velocity);  // strong, both components
+  void add_symmetry(const std::string& group);                      // u.n = 0 (axis-aligned)
+  // A prescribed normal traction sigma n = -p(t) n on a boundary group (a pressure inlet or
+  // outlet; Taylor-Hood only). The rest of the boundary without conditions is do-nothing (p = 0).
+  void add_pressure(const std::string& group, std::function<double(double)> pressure);
   void set_interface(const std::vector<std::string>& groups);                             // Nitsche groups
   void set_pressure_reference(const PointD& point, std::function<double(double)> value);  // nearest vertex
   void set_body_force(Velocity force);
@@ -225,6 +229,9 @@ class BasicFlowSolver {
   // P2/P1: every edge split at its midpoint).
   const std::vector<int>& interface_nodes() const { return interface_nodes_; }
   const IndexMatrix2& interface_segments() const { return interface_segments_; }
+  // 3D: the interface faces, 6-node triangles on the interface indices (gmsh order: the
+  // vertices a, b, c as in the mesh's boundary group, then the midpoints of ab, bc, ca).
+  const std::vector<std::array<int, 6>>& interface_faces() const { return interface_faces_; }
   // f_sigma = int N^T sigma n (n = fluid outward normal), the reaction plus the penalty term
   // gamma_N1 int N^T (v_f - v_s); f_v = int N^T v_f at the interface nodes (current configuration).
   Eigen::VectorXd interface_traction() const;
@@ -249,6 +256,7 @@ class BasicFlowSolver {
   int trial_solves_ = 0;  // solves of the current time level since the last accept()
   std::vector<int> interface_nodes_;
   IndexMatrix2 interface_segments_;
+  std::vector<std::array<int, 6>> interface_faces_;
   Eigen::VectorXd interface_velocity_;  // of the last solve
   std::function<void(int, double)> observer_;
   Step begin_step(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
@@ -257,7 +265,7 @@ class BasicFlowSolver {
 };
 
 using FlowSolver = BasicFlowSolver<2>;
-using FlowSolver3 = BasicFlowSolver<3>;  // no Nitsche interface, symmetry planes or remeshing yet
+using FlowSolver3 = BasicFlowSolver<3>;  // no remeshing yet
 extern template class BasicFlowSolver<2>;
 extern template class BasicFlowSolver<3>;
 

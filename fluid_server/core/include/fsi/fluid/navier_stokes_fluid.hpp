@@ -68,7 +68,9 @@ class NavierStokesFluid : public FluidModel {
   // Cumulative seconds: "mesh_motion" (extension), "assembly", "factorisation", "linear_solve"
   // (triangular solves and Krylov iterations), "step" (all of them, per solve call).
   std::map<std::string, double> timings() const override {
-    std::map<std::string, double> t{{"mesh_motion", motion_ ? motion_->seconds() : 0.0},
+    std::map<std::string, double> t{{"mesh_motion", motion_    ? motion_->seconds()
+                                                    : motion3_ ? motion3_->seconds()
+                                                               : 0.0},
                                     {"assembly", assembly_seconds_},
                                     {"factorisation", factor_seconds_},
                                     {"linear_solve", linear_solve_seconds_},
@@ -97,10 +99,13 @@ class NavierStokesFluid : public FluidModel {
   };
   FluidSetup setup_;
   std::string element_;  // fluid.element: p1p1 or p2p1
-  // fluid.dimension 3: the same FlowSolver on tetrahedra (fluid alone: no interface, no mesh motion).
+  // fluid.dimension 3: the same FlowSolver on tetrahedra, with a Nitsche interface of 6-node faces.
   std::unique_ptr<FlowSolver3> solver3_;
   std::vector<std::pair<std::string, Eigen::Vector3d>> pressure_probes3_;
   void configure3(const schema::Reader& section);
+  void configure_mesh_motion3(const schema::Reader& iface);
+  Eigen::MatrixX3d positions3(const Eigen::VectorXd& interface_displacement);
+  std::unique_ptr<MeshMotion3> motion3_;
   std::map<std::string, double> probes3();
   std::unique_ptr<FlowSolver> solver_;
   FluidMesh motion_mesh_;  // the mesh the extension runs on (P2: the vertices, or 4 linear triangles per element)
