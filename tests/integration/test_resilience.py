@@ -157,6 +157,9 @@ RESUME_CASES = {
     "sdof_3d": ("sdof_3d.yaml", ["time.end=40", "time.checkpoint_every=100", "time.output_every=0",
                                  "fluid.added_mass=0.8", "coupling.acceleration=iqn-ils", "coupling.relaxation=0.5",
                                  "coupling.iterations={max: 20, tolerance: 1.0e-8}"], 1450, 90),
+    # 3D FSI: the elastic tube (3D fluid with its Nitsche faces and MeshMotion3, Hex8 wall),
+    # resumed mid-pulse: the mesh motion's and the PETSc fluid's state across the checkpoint.
+    "tube_3d": ("tube_3d.yaml", ["time.end=0.0012", "time.checkpoint_every=4"], 7, 300),
     "thick_beam_imvj": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10", "coupling.algorithm=2",
                                             "coupling.acceleration=iqn-imvj", "coupling.predictor=quadratic",
                                             "coupling.iqn={imvj: {restart: rs-ls, chunk_size: 4, restart_reuse_steps: 2}, "
@@ -230,6 +233,10 @@ def resume_remesh(env):
 
 def resume_fsi3(env):
     resume_case(env, "fsi3_iqn", "SIGINT")
+
+
+def resume_tube_3d(env):
+    resume_case(env, "tube_3d", "SIGINT")
 
 
 def resume_external(env):
@@ -764,7 +771,7 @@ def full_disk(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_refused, fork,
+    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, resume_refused, fork,
                                   recover_kill, recover_kill_fenics, recover_stop, recover_gives_up, exit_paths,
                                   coupler_death, orphan_servers, vtk_output, write_failure, full_disk,
                                   resume_external, resume_before_summary, growth)})

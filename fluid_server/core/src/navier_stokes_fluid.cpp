@@ -1111,6 +1111,9 @@ void NavierStokesFluid::save_state(StateArchive& state) {
     solver3_->save_state(state, "flow.");
     if (motion3_) motion3_->save_state(state, "mesh.");
     state.put("fluid.last_interface_displacement", last_interface_displacement_);
+    state.put("fluid.factorisations", static_cast<std::int64_t>(factorisations_));
+    state.put("fluid.solves", static_cast<std::int64_t>(solves_));
+    state.put("fluid.linear_iterations", static_cast<std::int64_t>(linear_iterations_));
     return;
   }
   if (!solver_) throw std::logic_error("NavierStokesFluid::save_state before configure()");
@@ -1139,6 +1142,12 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
     solver3_->load_state(state, "flow.");
     if (motion3_) motion3_->load_state(state, "mesh.");
     last_interface_displacement_ = accepted_interface_displacement_ = last;
+    // The cumulative counters of probes.csv (a resumed run's table equals a straight run's).
+    if (state.has("fluid.factorisations")) {
+      factorisations_ = static_cast<int>(state.integer("fluid.factorisations"));
+      solves_ = static_cast<int>(state.integer("fluid.solves"));
+      linear_iterations_ = static_cast<int>(state.integer("fluid.linear_iterations"));
+    }
     return;
   }
   if (!solver_) throw std::logic_error("NavierStokesFluid::load_state before configure()");
