@@ -695,6 +695,15 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
       differ.push_back(d);
   }
   if (!differ.empty()) {
+    // Another scene file altogether: say so first (the key list of two different scenes is long).
+    const std::string was = ckpt->manifest.value("scene_file", std::string());
+    std::error_code ec;
+    if (!was.empty() && !fs::equivalent(fs::path(was), fs::path(o.scene_path), ec) &&
+        ckpt->manifest.value("scene", std::string()) != scene.name())
+      refuse(
+          fmt::format("this folder was run with {} (scene '{}'), not {}: give that scene to --resume ({} keys "
+                      "differ)",
+                      was, ckpt->manifest.value("scene", std::string()), o.scene_path, differ.size()));
     std::string list;
     for (const auto& d : differ) list += "\n  " + d;
     refuse(fmt::format("the scene differs from the one checkpoint {} was written with (only time.end may change):{}",

@@ -62,6 +62,9 @@ def resume_mismatched_scene(tmp):
     run_ok(SCENE, "--out", out, "--set", "time.checkpoint_every=50", "--set", "time.end=4")
     refused_unchanged(out, [SCENE, "--out", out, "--resume", "--set", "solid.mass=2"],
                       "the scene differs from the one checkpoint")
+    # Another scene file altogether: named first, not a list of every key that differs.
+    refused_unchanged(out, ["configs/added_mass.yaml", "--out", out, "--resume"],
+                      f"this folder was run with {SCENE} (scene 'sdof_model'), not configs/added_mass.yaml")
     # A completed run without a longer time.end: nothing to do (exit 0), nothing touched.
     refused_unchanged(out, [SCENE, "--out", out, "--resume"], "the run is complete", expected_code=0)
 
