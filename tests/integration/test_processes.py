@@ -294,6 +294,19 @@ def config_errors(env):
     code, log = env.fsi("sdof_model.yaml", env.out("type"), "coupling.relaxation=fast")
     assert code != 0 and "'coupling.relaxation' must be a number" in log, log
     print("config errors reported:", [l for l in log.splitlines() if "relaxation" in l][-1][-90:])
+    # A 3D solid (plate) with a 2D fluid: refused at the interface exchange, naming both servers.
+    with open(env.config("sdof_3d.yaml")) as f:
+        text = f.read()
+    fluid = text.index("\nfluid:")
+    mixed = env.out("mixed_dimensions.yaml")
+    with open(mixed, "w") as f:
+        f.write(text[:fluid] + "\nfluid:\n  model: surrogate\n  force: [0, 1.282]\n  added_mass: 0.0\n")
+    out = env.out("mixed")
+    code, log = env.run([env.exe("fsi"), "run", mixed, "--out", out])
+    reason = summary(out)["reason"]
+    assert code == 1 and "interface mismatch: the solid's interface is 3D (3 values per node), the fluid's 2D" in reason \
+        and "solid 'fsi solid_server" in reason and "fluid 'fsi fluid_server" in reason, (code, reason)
+    print("mixed dimensions refused:", reason[:160])
 
 
 def interrupt(env):
