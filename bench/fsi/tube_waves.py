@@ -150,8 +150,8 @@ def main():
             worst_arrival = max(abs(d["arrival_rel"]) for d in diff.values())
             res["against_reference"] = {"reference": a.reference, "stations": diff,
                                         "max_peak_rel": worst_peak, "max_arrival_rel": worst_arrival}
-            print(f"  against {a.reference}: peaks within {100 * worst_peak:.3f} %, arrival times within "
-                  f"{100 * worst_arrival:.3f} % (z = 1.25, 2.5, 3.75 cm; pressure and wall)")
+            print(f"  against {a.reference}: peaks within {100 * worst_peak:.2g} %, arrival times within "
+                  f"{100 * worst_arrival:.2g} % (z = 1.25, 2.5, 3.75 cm; pressure and wall)")
         report["runs"].append(res)
     print(f"theory: Moens-Korteweg {th['moens_korteweg_inner_cm_per_s'] / 100:.2f} m/s (inner radius), "
           f"{th['moens_korteweg_mid_cm_per_s'] / 100:.2f} m/s (mid-wall); with the wall's inertia at the pulse's "

@@ -31,9 +31,27 @@ def num(s):
         return None
 
 
+X_LABELS = {"wall_time": "wall time of the run (s)", "cpu_time": "CPU time of the run (s)",
+            "coupling_iterations": "coupling iterations of the run (each one fluid and one solid solve)"}
+
+
+def metric_label(metric):
+    """'solid.r2_x.l2_rel' -> 'relative L2 error of solid.r2_x' (the study metrics' names)."""
+    forms = {"l2_rel": "relative L2 error", "l2": "L2 error", "max_rel": "largest relative error",
+             "max_abs": "largest error", "steady_rel": "relative error of the steady value",
+             "mean_rel": "relative error of the mean", "amplitude_rel": "relative error of the amplitude"}
+    probe, _, form = metric.rpartition(".")
+    return f"{forms[form]} of {probe}" if probe and form in forms else metric
+
+
 def plot_work_precision(plt, d, rows, meta, cfg):
-    """Error against wall time, one line per group of `lines`; `metric` is one column or a list
-    of columns (one panel each, e.g. a displacement amplitude and a force frequency)."""
+    """Error against cost (wall time by default; `x: cpu_time` or `coupling_iterations` where
+    process start-up or a shared machine would dominate wall time), one line per group of
+    `lines`; each point names the varied values its line does not (e.g. g=100). `metric` is one
+    column or a list of columns (one panel each). Runs that did not complete are counted in a
+    note on the figure (outcomes.png shows them)."""
+    import textwrap
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
     probes = meta.get("probes") or []
     if not probes:
         return None
@@ -41,11 +59,14 @@ def plot_work_precision(plt, d, rows, meta, cfg):
     metrics = [metrics] if isinstance(metrics, str) else list(metrics)
     xkey = cfg.get("x", "wall_time")
     color_key = cfg.get("color", "coupling.algorithm")
-    line_keys = cfg.get("lines", [k for k in meta.get("varied", []) if k not in ("time.dt", "fluid.mesh.size")])
-    runs = [r for r in rows if r["name"] and not is_reference_row(r, meta) and num(r.get(xkey))]
+    varied = [k for k in meta.get("varied", [])]
+    line_keys = cfg.get("lines", [k for k in varied if k not in ("time.dt", "fluid.mesh.size")])
+    point_keys = [k for k in varied if k not in line_keys and k != color_key]
+    sweep = [r for r in rows if r["name"] and not is_reference_row(r, meta)]
+    runs = [r for r in sweep if num(r.get(xkey))]
     if not any(num(r.get(m)) for r in runs for m in metrics):
         return None
-    fig, axes = plt.subplots(1, len(metrics), figsize=(7 if len(metrics) == 1 else 5.5 * len(metrics), 5),
+    fig, axes = plt.subplots(1, len(metrics), figsize=(7.5 if len(metrics) == 1 else 5.5 * len(metrics), 5.2),
                              squeeze=False)
     cyc = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     markers = "osD^v<>px*h"
@@ -55,6 +76,7 @@ def plot_work_precision(plt, d, rows, meta, cfg):
         for r in runs:
             if num(r.get(metric)) is not None:
                 groups.setdefault(tuple(r.get(k, "") for k in line_keys), []).append(r)
+        xs_all = []
         for g, rs in sorted(groups.items()):
             rs.sort(key=lambda r: num(r[xkey]))
             ckey = rs[0].get(color_key, "")
@@ -62,21 +84,37 @@ def plot_work_precision(plt, d, rows, meta, cfg):
             other = tuple(v for k, v in zip(line_keys, g) if k != color_key)
             mk.setdefault(other, markers[len(mk) % len(markers)])
             label = ", ".join(f"{ABBREV.get(k, k)}={v}" for k, v in zip(line_keys, g))
-            ax.loglog([num(r[xkey]) for r in rs], [max(num(r[metric]), 1e-300) for r in rs], "-",
-                      marker=mk[other], color=colors[ckey], label=label)
+            xs = [num(r[xkey]) for r in rs]
+            xs_all += xs
+            ax.plot(xs, [max(num(r[metric]), 1e-300) for r in rs], "-", marker=mk[other], color=colors[ckey],
+                    label=label)
+            within = [k for k in point_keys if len({r.get(k, "") for r in rs}) > 1]  # what moves along the line
+            spots = {}  # coincident points (the same run under another name) share one label
             for r in rs:
-                if "time.dt" in r:
-                    ax.annotate(f"dt={r['time.dt']}", (num(r[xkey]), num(r[metric])), fontsize=6, alpha=0.6,
-                                textcoords="offset points", xytext=(3, 3))
-        ax.set_xlabel("wall time [s]" if xkey == "wall_time" else xkey)
-        ax.set_ylabel(metric)
+                spots.setdefault((num(r[xkey]), num(r[metric])), []).append(r)
+            for (x, y), same in spots.items():
+                tag = ", ".join(f"{ABBREV.get(k, k)}=" + " / ".join(dict.fromkeys(r[k] for r in same)) for k in within)
+                if tag:
+                    ax.annotate(tag, (x, y), fontsize=7, alpha=0.75, textcoords="offset points", xytext=(4, 4))
+        ax.set_yscale("log")
+        if xs_all and max(xs_all) > 10 * min(xs_all):
+            ax.set_xscale("log")
+        else:  # within a decade: a linear axis with plain numbers (no overlapping 1.3x10^2 labels)
+            ax.xaxis.set_major_formatter(ScalarFormatter(useOffset=False))
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel(X_LABELS.get(xkey, xkey))
+        ax.set_ylabel(metric_label(metric))
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=1 if len(metrics) > 1 else 2)
-    title = cfg.get("title", f"{meta.get('study', '')}: error against wall time")
+    title = cfg.get("title", f"{meta.get('study', '')}: error against {X_LABELS.get(xkey, xkey).split(' (')[0]}")
+    missing = [r for r in sweep if r.get("outcome") != "completed"]
+    if missing:
+        title += f" (not shown: {len(missing)} of {len(sweep)} runs did not complete, see outcomes.png)"
+    wrapped = textwrap.fill(title, 70 if len(metrics) == 1 else 110)
     if len(metrics) == 1:
-        axes[0][0].set_title(title)
+        axes[0][0].set_title(wrapped, fontsize=10)
     else:
-        fig.suptitle(title)
+        fig.suptitle(wrapped, fontsize=10)
     fig.tight_layout()
     path = Path(d) / cfg.get("file", "work_precision.png")
     fig.savefig(path, dpi=120)
