@@ -93,8 +93,13 @@ RUN = {
     "build/bin/fsi run configs/dfg_2d1.yaml --out out/dfg_2d1": ("append", COARSE_DFG),
     "python3 bench/fluid/dfg_2d1_refinement.py --fsi build/bin/fsi --out out/dfg_2d1_refinement": ("append", "--levels 1"),
     "OPENBLAS_NUM_THREADS=1 build/bin/fsi run configs/dfg_2d2.yaml --out out/dfg_2d2": ("append", "--set time.end=0.05"),
+    # docs/fsi3d.md: the elastic tube, 6 of its 100 steps; the wave analysis of that short run.
+    "build/bin/fsi run configs/tube_3d.yaml --out runs/tube": ("append", "--set time.end=0.0006"),
+    "/usr/bin/python3 bench/fsi/tube_waves.py runs/tube --plot tube.png": None,
 }
 SKIP = {
+    "build/bin/fsi study studies/tube_3d.yaml --out runs/study_tube --jobs 1":
+        "benchmark: 13 coupled 3D runs, 20 minutes (docs/fsi3d.md)",
     "scripts/quickstart.sh": "installs apt packages (sudo) and builds: the fresh-Debian check, not CI",
     "scripts/test.sh": "installs apt packages, builds and runs all of ctest, which runs this test",
     "build/bin/fsi study studies/thin_beam_beta.yaml --out runs/study_thin_beta --jobs 2":
