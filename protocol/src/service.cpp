@@ -1,13 +1,17 @@
 #include "fsi/protocol/service.hpp"
 
 #include <fmt/format.h>
+#include <google/protobuf/io/coded_stream.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <csignal>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "fsi/common/log.hpp"
 #include "fsi/common/utf8.hpp"
@@ -22,6 +26,55 @@ void set_error(fsi::v1::Reply& reply, fsi::v1::Error::Code code, const std::stri
   reply.clear_body();
   reply.mutable_error()->set_code(code);
   reply.mutable_error()->set_message(fsi::valid_utf8(message));  // else the reply would not parse
+}
+
+// The request's body (its field number in Request and its length), read from the wire before
+// parsing: requests without bulk data have a size limit, so a huge Hello is refused without
+// the memory its parse would take. Nothing when the bytes do not look like a Request (the
+// parser then says what is wrong).
+std::optional<std::pair<int, std::uint64_t>> peek_body(const std::string& bytes) {
+  google::protobuf::io::CodedInputStream in(reinterpret_cast<const std::uint8_t*>(bytes.data()),
+                                            static_cast<int>(std::min<std::size_t>(bytes.size(), INT32_MAX)));
+  while (true) {
+    const std::uint32_t tag = in.ReadTag();
+    if (tag == 0) return std::nullopt;
+    const int field = static_cast<int>(tag >> 3), wire = static_cast<int>(tag & 7);
+    std::uint64_t value = 0;
+    if (wire == 0) {  // protocol_version, sequence
+      if (!in.ReadVarint64(&value)) return std::nullopt;
+    } else if (wire == 2) {
+      std::uint32_t length = 0;
+      if (!in.ReadVarint32(&length)) return std::nullopt;
+      if (field >= 10) return std::make_pair(field, static_cast<std::uint64_t>(length));
+      if (!in.Skip(static_cast<int>(length))) return std::nullopt;
+    } else {
+      return std::nullopt;
+    }
+  }
+}
+
+// Request kinds that carry no bulk data, and the size a request of that kind may have.
+constexpr std::size_t kSmallRequestLimit = 1u << 20;       // hello, get_interface, accept, output, stop, save
+constexpr std::size_t kConfigureRequestLimit = 64u << 20;  // a scene's text and overrides
+std::optional<std::pair<const char*, std::size_t>> request_limit(int field) {
+  switch (field) {
+    case 10:
+      return std::make_pair("hello", kSmallRequestLimit);
+    case 11:
+      return std::make_pair("configure", kConfigureRequestLimit);
+    case 12:
+      return std::make_pair("get_interface", kSmallRequestLimit);
+    case 14:
+      return std::make_pair("accept_step", kSmallRequestLimit);
+    case 15:
+      return std::make_pair("write_output", kSmallRequestLimit);
+    case 16:
+      return std::make_pair("stop", kSmallRequestLimit);
+    case 18:
+      return std::make_pair("save_checkpoint", kSmallRequestLimit);
+    default:
+      return std::nullopt;  // solve_step, initial_loads, load_checkpoint: interface data and states
+  }
 }
 
 // Checks a received vector: expected size and every entry finite.
@@ -182,6 +235,17 @@ std::string Service::before_configure(const std::string& request) const {
 }
 
 std::string Service::handle_bytes(const std::string& bytes, bool& stop, const std::string& peer) {
+  if (const auto body = peek_body(bytes)) {
+    if (const auto limit = request_limit(body->first); limit && bytes.size() > limit->second) {
+      fsi::v1::Reply reply;
+      reply.set_protocol_version(kProtocolVersion);
+      set_error(reply, fsi::v1::Error::MALFORMED,
+                fmt::format("a '{}' request of {} bytes exceeds the {} bytes such a request may have: refused "
+                            "unread",
+                            limit->first, bytes.size(), limit->second));
+      return reply.SerializeAsString();
+    }
+  }
   fsi::v1::Request request;
   if (!request.ParseFromString(bytes)) {
     fsi::v1::Reply reply;

@@ -138,6 +138,9 @@ def bad_messages(env):
     r.protocol_version = 2
     expect_error(call(r), pb.Error.VERSION_MISMATCH, "version")
     expect_error(call(pb.Request(protocol_version=1, sequence=2)), pb.Error.MALFORMED, "no body")
+    # A request without bulk data is refused above its size limit before it is parsed (a 2 MiB Hello).
+    huge = request(2, hello=pb.Hello(client_name="x" * (2 << 20)))
+    expect_error(call(huge), pb.Error.MALFORMED, "a 'hello' request of 2097")
     step = pb.SolveStep(time=0.02, dt=0.02, step=1, iteration=1, interface_force=[1.0, 0.0])
     expect_error(call(request(3, solve_step=step)), pb.Error.BAD_SEQUENCE, "before 'configure'")
     with open(env.config("sdof_model.yaml")) as f:
