@@ -432,6 +432,31 @@ def recover_kill(env):
     recovery_trials(env, "solid", "kill", TRIALS or 2, 2)
 
 
+def recover_kill_3d(env):
+    """kill -9 in 3D FSI: the elastic tube (configs/tube_3d.yaml, 12 steps, a checkpoint every 4):
+    the 3D fluid (PETSc, its Nitsche faces and MeshMotion3) killed at step 6, the Hex8 solid at
+    step 9; each time the launcher starts the server again, the coupler resumes from the last
+    checkpoint and the run ends identical to the uninterrupted one."""
+    sets = ["time.end=0.0012", "time.checkpoint_every=4"]
+    ref = env.out("recover3d_ref")
+    code, log = finish(launch(env, "tube_3d.yaml", ref, sets), 300)
+    assert code == 0, log[-2000:]
+    for victim, at in (("fluid", 6), ("solid", 9)):
+        out = env.out(f"recover3d_{victim}")
+        p = launch(env, "tube_3d.yaml", out, sets)
+        wait_rows(os.path.join(out, "probes.csv"), at, p, 300)
+        server_of(p, victim).send_signal(signal.SIGKILL)
+        code, log = finish(p, 300)
+        s = assert_final(out, "completed", 0, code)
+        rec = s.get("recoveries", [])
+        assert len(rec) == 1 and rec[0]["process"] == f"{victim}_server", rec
+        assert_identical(ref, out)
+        assert_no_leftovers(out)
+        print(f"3D {victim} killed at row {at}: recovered ({rec[0]['cause']}, resumed from step "
+              f"{rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv and iterations.csv "
+              "identical")
+
+
 def recover_kill_fenics(env):
     """kill -9 of an external solid, the FEniCS one (python/examples/fenics_solid): thick_beam to
     T = 1 with that solid (its default element, Q1), a checkpoint every 5 steps; the solid is killed
@@ -771,7 +796,7 @@ def full_disk(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, resume_refused, fork,
+    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, recover_kill_3d, resume_refused, fork,
                                   recover_kill, recover_kill_fenics, recover_stop, recover_gives_up, exit_paths,
                                   coupler_death, orphan_servers, vtk_output, write_failure, full_disk,
                                   resume_external, resume_before_summary, growth)})
