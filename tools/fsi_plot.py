@@ -67,6 +67,13 @@ def plot_run(folder, quiet):
     stats = summary.get("statistics") or {}
     t = data[:, header.index("time")]
     shown = [c for c in header if c != "time" and not diagnostic(c)] or [c for c in header if c != "time"]
+    # Probes that are exactly zero throughout (a clamped point, a component the problem does not
+    # move) get no panel of their own: the title names them.
+    zero = [c for c in shown if np.all(data[:, header.index(c)] == 0)]
+    if len(zero) < len(shown):
+        shown = [c for c in shown if c not in zero]
+    else:
+        zero = []
     more = len(shown) - 8
     shown = shown[:8]
     fig, axes = plt.subplots(len(shown), 1, figsize=(9, 1.9 * len(shown) + 0.8), sharex=True, squeeze=False)
@@ -99,6 +106,8 @@ def plot_run(folder, quiet):
         title += f" ({summary['status']}, {summary.get('steps', len(t))} steps)"
     if more > 0:
         title += f"; {more} more probes in probes.csv"
+    if zero:
+        title += f"; zero throughout (not drawn): {', '.join(zero[:6])}" + (", ..." if len(zero) > 6 else "")
     wrap_title(axes[0, 0], title, fontsize=9)
     fig.tight_layout()
     path = folder / "histories.png"
