@@ -99,19 +99,25 @@ TEST(TetMesh, FromGmshOrientsTetrahedraAndTheTwoDimensionsRefuseEachOther) {
   EXPECT_THROW((void)TetMesh::from_gmsh(fsi::read_gmsh(in2, "tri.msh")), std::runtime_error);
 }
 
-// Plane Poiseuille flow between y = 0 and y = H in a box with symmetry planes z = const:
-// u = 4 U y (H - y) / H^2, p = 8 mu U (L - x) / H^2 (do-nothing outlet at x = L: p = 0).
-TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
-  const double L = 2, H = 1, U = 1.5, mu = 0.1;
-  TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1);
+// Steady Newton to 1e-12 without SUPG or factor reuse: the settings of every exact-solution case here.
+FlowParameters steady_newton(double viscosity) {
   FlowParameters params;
-  params.viscosity = mu;
+  params.viscosity = viscosity;
   params.scheme = TimeScheme::Steady;
   params.newton = true;
   params.max_iterations = 8;
   params.tolerance = 1e-12;
   params.stabilisation.supg = false;
   params.reuse_factorisation = false;
+  return params;
+}
+
+// Plane Poiseuille flow between y = 0 and y = H in a box with symmetry planes z = const:
+// u = 4 U y (H - y) / H^2, p = 8 mu U (L - x) / H^2 (do-nothing outlet at x = L: p = 0).
+TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
+  const double L = 2, H = 1, U = 1.5, mu = 0.1;
+  TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1);
+  FlowParameters params = steady_newton(mu);
   FlowSolver3 solver(mesh, params, "p2p1");
   EXPECT_EQ(solver.dofs(), 3 * solver.mesh().node_count() + solver.mesh().vertices());
   auto exact = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
@@ -156,14 +162,7 @@ struct PoiseuilleRun {
 };
 PoiseuilleRun poiseuille(LinearEngine engine, const std::string& petsc_options = "") {
   const double L = 2, H = 1, U = 1.5, mu = 0.1;
-  FlowParameters params;
-  params.viscosity = mu;
-  params.scheme = TimeScheme::Steady;
-  params.newton = true;
-  params.max_iterations = 8;
-  params.tolerance = 1e-12;
-  params.stabilisation.supg = false;
-  params.reuse_factorisation = false;
+  FlowParameters params = steady_newton(mu);
   params.engine = engine;
   params.petsc_options = petsc_options;
   FlowSolver3 solver(TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1), params, "p2p1");
@@ -226,14 +225,7 @@ TEST(FlowSolver3, PetscRefusesAnUnknownOptionNamingIt) {
 TEST(FlowSolver3Nitsche, TranslationOfTheWholeBoxIsExact) {
   const Eigen::Vector3d V(0.3, -0.2, 0.5);
   TetMesh mesh = TetMesh::box({0, 0, 0}, {1, 0.8, 0.6}, 2, 2, 2);
-  FlowParameters params;
-  params.viscosity = 0.05;
-  params.scheme = TimeScheme::Steady;
-  params.newton = true;
-  params.max_iterations = 8;
-  params.tolerance = 1e-12;
-  params.stabilisation.supg = false;
-  params.reuse_factorisation = false;
+  FlowParameters params = steady_newton(0.05);
   params.nitsche_penalty = 100;
   FlowSolver3 solver(mesh, params, "p2p1");
   solver.set_interface({"left", "right", "bottom", "top", "back", "front"});
@@ -263,14 +255,7 @@ TEST(FlowSolver3Nitsche, TranslationOfTheWholeBoxIsExact) {
 TEST(FlowSolver3Nitsche, PoiseuilleWithNitscheInletAndWallsIsExactAndItsTractionIsTheShear) {
   const double L = 2, H = 1, U = 1.5, mu = 0.1, W = 0.5;
   TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, W}, 4, 2, 1);
-  FlowParameters params;
-  params.viscosity = mu;
-  params.scheme = TimeScheme::Steady;
-  params.newton = true;
-  params.max_iterations = 8;
-  params.tolerance = 1e-12;
-  params.stabilisation.supg = false;
-  params.reuse_factorisation = false;
+  FlowParameters params = steady_newton(mu);
   params.nitsche_penalty = 50;
   FlowSolver3 solver(mesh, params, "p2p1");
   auto exact = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
@@ -317,14 +302,7 @@ TEST(FlowSolver3Nitsche, PoiseuilleWithNitscheInletAndWallsIsExactAndItsTraction
 TEST(FlowSolver3, PressureInletDrivesExactPoiseuille) {
   const double L = 2, H = 1, mu = 0.1, p_in = 0.6;
   TetMesh mesh = TetMesh::box({0, 0, 0}, {L, H, 0.5}, 4, 2, 1);
-  FlowParameters params;
-  params.viscosity = mu;
-  params.scheme = TimeScheme::Steady;
-  params.newton = true;
-  params.max_iterations = 8;
-  params.tolerance = 1e-12;
-  params.stabilisation.supg = false;
-  params.reuse_factorisation = false;
+  FlowParameters params = steady_newton(mu);
   FlowSolver3 solver(mesh, params, "p2p1");
   const auto zero = [](const Eigen::Vector3d&, double) { return Eigen::Vector3d::Zero().eval(); };
   solver.add_dirichlet("bottom", zero);
