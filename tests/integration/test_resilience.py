@@ -403,26 +403,31 @@ def recovery_trials(env, victim, how, trials, seed):
     rng = random.Random(seed)
     total = rows(os.path.join(ref, "probes.csv"))
     for trial in range(trials):
-        at = rng.randint(3, total - 5)
-        out = env.out(f"recover_{victim}_{how}_{trial}")
-        extra = ("--timeout", "3") if how == "stop" else ()
-        p = launch(env, "thick_beam.yaml", out, RECOVER_SETS, extra)
-        wait_rows(os.path.join(out, "probes.csv"), at, p, 300)
-        server = server_of(p, victim)
-        server.send_signal(signal.SIGKILL if how == "kill" else signal.SIGSTOP)
-        code, log = finish(p, 300)
-        s = assert_final(out, "completed", 0, code)
-        rec = s.get("recoveries", [])
-        assert len(rec) == 1 and rec[0]["process"] == f"{victim}_server", rec
-        assert_identical(ref, out)
-        assert_no_leftovers(out)
-        if how == "stop":
-            try:
-                server.send_signal(signal.SIGKILL)
-            except psutil.Error:
-                pass
-        print(f"{victim} {how} at row {at}: recovered ({rec[0]['cause']}, resumed from step "
-              f"{rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv identical")
+        interrupt_and_recover(env, "thick_beam.yaml", RECOVER_SETS, ref, env.out(f"recover_{victim}_{how}_{trial}"),
+                              victim, how, rng.randint(3, total - 5))
+
+
+def interrupt_and_recover(env, scene, sets, ref, out, victim, how, at):
+    """One trial: the run is started, its victim server killed (or stopped) at row `at`; the run
+    must recover once and end identical to the uninterrupted `ref`."""
+    extra = ("--timeout", "3") if how == "stop" else ()
+    p = launch(env, scene, out, sets, extra)
+    wait_rows(os.path.join(out, "probes.csv"), at, p, 300)
+    server = server_of(p, victim)
+    server.send_signal(signal.SIGKILL if how == "kill" else signal.SIGSTOP)
+    code, log = finish(p, 300)
+    s = assert_final(out, "completed", 0, code)
+    rec = s.get("recoveries", [])
+    assert len(rec) == 1 and rec[0]["process"] == f"{victim}_server", rec
+    assert_identical(ref, out)
+    assert_no_leftovers(out)
+    if how == "stop":
+        try:
+            server.send_signal(signal.SIGKILL)
+        except psutil.Error:
+            pass
+    print(f"{scene}: {victim} {how} at row {at}: recovered ({rec[0]['cause']}, resumed from step "
+          f"{rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv and iterations.csv identical")
 
 
 # The test runs a few trials; the acceptance benchmark (bench/fsi/recovery_trials.sh) sets
@@ -445,19 +450,7 @@ def recover_kill_3d(env):
     code, log = finish(launch(env, "tube_3d.yaml", ref, sets), 300)
     assert code == 0, log[-2000:]
     for victim, at in (("fluid", 4), ("solid", 7)):
-        out = env.out(f"recover3d_{victim}")
-        p = launch(env, "tube_3d.yaml", out, sets)
-        wait_rows(os.path.join(out, "probes.csv"), at, p, 300)
-        server_of(p, victim).send_signal(signal.SIGKILL)
-        code, log = finish(p, 300)
-        s = assert_final(out, "completed", 0, code)
-        rec = s.get("recoveries", [])
-        assert len(rec) == 1 and rec[0]["process"] == f"{victim}_server", rec
-        assert_identical(ref, out)
-        assert_no_leftovers(out)
-        print(f"3D {victim} killed at row {at}: recovered ({rec[0]['cause']}, resumed from step "
-              f"{rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv and iterations.csv "
-              "identical")
+        interrupt_and_recover(env, "tube_3d.yaml", sets, ref, env.out(f"recover3d_{victim}"), victim, "kill", at)
 
 
 def recover_kill_fenics(env):
