@@ -1125,20 +1125,30 @@ void NavierStokesFluid::save_state(StateArchive& state) {
   state.put("fluid.solves", static_cast<std::int64_t>(solves_));
 }
 
+namespace {
+// A checkpoint's interface displacement of the last step (both dimensions): the state and this
+// configuration agree on a moving mesh and on the number of values (`required`: 2D states have
+// always held it; 3D ones written before the 3D interface did not).
+Eigen::VectorXd checked_last_displacement(const StateArchive& state, bool moving, std::size_t values, bool required) {
+  if (!moving && state.has("mesh.base_displacement"))
+    throw StateError(
+        "entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
+  const Eigen::VectorXd last = required || state.has("fluid.last_interface_displacement")
+                                   ? state.vector("fluid.last_interface_displacement")
+                                   : Eigen::VectorXd();
+  if (last.size() != 0 && last.size() != static_cast<Eigen::Index>(values))
+    throw StateError(
+        fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration "
+                    "needs {} (a different mesh or scene?)",
+                    last.size(), values));
+  return last;
+}
+}  // namespace
+
 void NavierStokesFluid::load_state(const StateArchive& state) {
   if (solver3_) {
-    if (!motion3_ && state.has("mesh.base_displacement"))
-      throw StateError(
-          "entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
-    const Eigen::VectorXd last = state.has("fluid.last_interface_displacement")
-                                     ? state.vector("fluid.last_interface_displacement")
-                                     : Eigen::VectorXd();
-    const auto interface_size = 3 * static_cast<Eigen::Index>(solver3_->interface_nodes().size());
-    if (last.size() != 0 && last.size() != interface_size)
-      throw StateError(
-          fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration "
-                      "needs {} (a different mesh or scene?)",
-                      last.size(), interface_size));
+    const Eigen::VectorXd last =
+        checked_last_displacement(state, motion3_ != nullptr, 3 * solver3_->interface_nodes().size(), false);
     solver3_->load_state(state, "flow.");
     if (motion3_) motion3_->load_state(state, "mesh.");
     last_interface_displacement_ = accepted_interface_displacement_ = last;
@@ -1155,16 +1165,8 @@ void NavierStokesFluid::load_state(const StateArchive& state) {
     throw StateError(
         fmt::format("entry 'flow.element' is '{}', this configuration uses fluid.element {}", saved, element_));
   load_remeshed(state);  // the state's mesh (the scene's, or a remeshed one)
-  if (!motion_ && state.has("mesh.base_displacement"))
-    throw StateError(
-        "entry 'mesh.base_displacement': the state has a moving mesh, this configuration has no interface");
-  const Eigen::VectorXd last = state.vector("fluid.last_interface_displacement");
-  const auto interface_size = 2 * static_cast<Eigen::Index>(solver_->interface_nodes().size());
-  if (last.size() != 0 && last.size() != interface_size)
-    throw StateError(
-        fmt::format("entry 'fluid.last_interface_displacement' has {} values, this configuration needs {} "
-                    "(a different mesh or scene?)",
-                    last.size(), interface_size));
+  const Eigen::VectorXd last =
+      checked_last_displacement(state, motion_ != nullptr, 2 * solver_->interface_nodes().size(), true);
   const auto factorisations = state.integer("fluid.factorisations"), solves = state.integer("fluid.solves");
   solver_->load_state(state, "flow.");
   if (motion_) motion_->load_state(state, "mesh.");
