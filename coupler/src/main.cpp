@@ -167,6 +167,8 @@ void fill_times(fsi::RunReport& report, Clock::time_point start, const Servers& 
   if (coupler && coupler->times().checkpoint > 0) w["checkpoint"] = coupler->times().checkpoint;
   if (solid && !solid->timings().empty()) w["solid_breakdown"] = solid->timings();
   if (fluid && !fluid->timings().empty()) w["fluid_breakdown"] = fluid->timings();
+  if (solid && !solid->diagnostics().empty()) report.data()["solid_diagnostics"] = solid->diagnostics();
+  if (fluid && !fluid->diagnostics().empty()) report.data()["fluid_diagnostics"] = fluid->diagnostics();
   report.data()["steps"] = outcome.steps;
   report.data()["coupling_iterations"] = outcome.iterations;
 }
@@ -289,5 +291,12 @@ int main(int argc, char** argv) {
               o.out_dir);
   else
     log->error("{}: {}", outcome.status, outcome.reason);
+  for (const auto& [side, data] : {std::pair{"solid", report.data().value("solid_diagnostics", nlohmann::json())},
+                                   std::pair{"fluid", report.data().value("fluid_diagnostics", nlohmann::json())}}) {
+    std::string text;
+    for (const auto& [key, value] : data.items())
+      text += fmt::format("{}{} {:.6g}", text.empty() ? "" : ", ", key, value.get<double>());
+    if (!text.empty()) log->info("{} diagnostics: {}", side, text);
+  }
   return outcome.exit_code();
 }

@@ -289,7 +289,8 @@ Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, const 
 
 // Calls both remote models make the same way.
 std::map<std::string, double> accept_call(ProtocolClient& client, const StepInfo& info,
-                                          std::map<std::string, double>& timings) {
+                                          std::map<std::string, double>& timings,
+                                          std::map<std::string, double>& diagnostics) {
   fsi::v1::Request r;
   r.mutable_accept_step()->set_time(info.time);
   r.mutable_accept_step()->set_step(static_cast<unsigned>(info.step));
@@ -307,6 +308,7 @@ std::map<std::string, double> accept_call(ProtocolClient& client, const StepInfo
           fsi::v1::Error::INVALID_ARGUMENT,
           fmt::format("{} sent timing '{}' = {} (must be finite and >= 0)", client.peer_name(), name, value));
   timings = {reply.accept().timings().begin(), reply.accept().timings().end()};
+  diagnostics = {reply.accept().diagnostics().begin(), reply.accept().diagnostics().end()};
   return {reply.accept().probes().begin(), reply.accept().probes().end()};
 }
 
@@ -389,7 +391,7 @@ SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::Vecto
 }
 
 std::map<std::string, double> RemoteSolid::accept_step(const StepInfo& info) {
-  return accept_call(*client_, info, timings_);
+  return accept_call(*client_, info, timings_, diagnostics_);
 }
 
 std::vector<std::string> RemoteSolid::write_output(const StepInfo& info) { return output_call(*client_, info); }
@@ -454,7 +456,7 @@ FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& 
 }
 
 std::map<std::string, double> RemoteFluid::accept_step(const StepInfo& info) {
-  return accept_call(*client_, info, timings_);
+  return accept_call(*client_, info, timings_, diagnostics_);
 }
 
 std::vector<std::string> RemoteFluid::write_output(const StepInfo& info) { return output_call(*client_, info); }

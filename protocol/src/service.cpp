@@ -140,6 +140,7 @@ bool handle_shared(const fsi::v1::Request& request, fsi::v1::Reply& reply, bool&
     auto* out = reply.mutable_accept();
     for (const auto& [k, v] : model->accept_step(info)) (*out->mutable_probes())[fsi::valid_utf8(k)] = v;
     for (const auto& [k, v] : model->timings()) (*out->mutable_timings())[k] = v;
+    for (const auto& [k, v] : model->diagnostics()) (*out->mutable_diagnostics())[fsi::valid_utf8(k)] = v;
   } else if (body == R::kSaveCheckpoint || body == R::kLoadCheckpoint) {
     if (!model->supports_checkpoint())
       throw RemoteError(fsi::v1::Error::UNSUPPORTED,

@@ -60,6 +60,10 @@ The methods (positional arguments, in this order):
 ``timings() -> dict`` (optional)
     Cumulative wall seconds of your solver by category ("assembly", "linear_solve", ...),
     sent with every AcceptReply: summary.json shows the last as ``wall_time.solid_breakdown``.
+``diagnostics() -> dict`` (optional)
+    Statistics of the run so far (e.g. contact with the scene's ``solid.obstacles``:
+    "contact_active_time", "contact_min_gap"), sent with every AcceptReply: summary.json shows
+    the last as ``solid_diagnostics``. Keep them in your checkpoint state.
 ``write_output(step, time) -> list of file names`` (optional)
     With it, ``supports_output = true``.
 ``set_interface_mass(matrix)`` (optional, Algorithm 2)
@@ -471,6 +475,9 @@ class Server:
             if _implements(s, "timings"):
                 for key, value in dict(s.timings() or {}).items():
                     reply.accept.timings[str(key)] = float(value)
+            if _implements(s, "diagnostics"):
+                for key, value in dict(s.diagnostics() or {}).items():
+                    reply.accept.diagnostics[str(key)] = float(value)
             self._take_snapshot()
         elif body in ("save_checkpoint", "load_checkpoint"):
             self._need_configured(body)

@@ -150,6 +150,20 @@ def out_of_range():
            "configs/fsi3.yaml (--set fluid.umfpack_irstep=3): 'fluid.umfpack_irstep' must be in [0, 2], got '3'\n")
 
 
+def obstacles():
+    """solid.obstacles: a negative contact gap or stiffness is refused at its line; the sdof solid has no
+    contact and names the model that has."""
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = edited(tmp, "thin_beam.yaml", [("contact_gap: 0.008", "contact_gap: -0.008, stiffness: -1")])
+        expect(["check", scene], 1, "",
+               f"{place(scene, 'contact_gap')}: 'solid.obstacles[0].contact_gap' must be > 0, got '-0.008'\n"
+               f"{place(scene, 'stiffness')}: 'solid.obstacles[0].stiffness' must be > 0, got '-1'\n")
+    expect(["check", "configs/sdof_model.yaml", "--set",
+            "solid.obstacles=[{point: [0, 0], normal: [0, 1], contact_gap: 0.01}]"], 1, "",
+           "configs/sdof_model.yaml (--set solid.obstacles=[{point: [0, 0], normal: [0, 1], contact_gap: 0.01}]): "
+           "unknown key 'solid.obstacles' for solid.model 'sdof' (it is a key of solid.model 'fem')\n")
+
+
 def override_typo():
     """A --set with a misspelt key names the override."""
     expect(["check", "configs/sdof_model.yaml", "--set", "coupling.relaxtion=0.5"], 1, "",
@@ -207,8 +221,8 @@ def reference_current():
     print(f"docs/scene-reference.md current ({len(current)} bytes)")
 
 
-CASES = {f.__name__: f for f in (shipped, solver_typos, misspelt_required, wrong_type, out_of_range, override_typo,
-                                 external_solver, study, reference_current)}
+CASES = {f.__name__: f for f in (shipped, solver_typos, misspelt_required, wrong_type, out_of_range, obstacles,
+                                 override_typo, external_solver, study, reference_current)}
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser()

@@ -173,6 +173,13 @@ RESUME_CASES = {
     # after step 15; the resumed run makes the remesh after step 25 itself.
     "thick_beam_remesh": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10",
                                               "fluid.remesh.at_steps=[15, 25]"], 27, 240),
+    # Contact: the 3D block, dynamic, swells sideways under the plate's push onto a rigid wall
+    # 0.03 beside it (contact gap 0.01) and stays in contact; the checkpoints are taken in contact.
+    "block_3d_contact": ("block_3d.yaml", ["time.dt=0.001", "time.end=2.0", "time.output_every=0",
+                                           "time.checkpoint_every=100", "solid.analysis=dynamic",
+                                           "solid.time_scheme=bdf1",
+                                           "solid.obstacles=[{point: [0.53, 0, 0], normal: [-1, 0, 0], "
+                                           "contact_gap: 0.01}]"], 1000, 60),
 }
 
 
@@ -219,6 +226,21 @@ def resume_small(env):
     resume_case(env, "sdof_3d", "kill -9 coupler")
     RESUME_CASES["python_solid_3d"] = RESUME_CASES["sdof_3d"]
     resume_case(env, "python_solid_3d", "SIGINT", ("--solid-command", solid))
+
+
+def resume_contact(env):
+    """A run resumed while the solid is in contact with an obstacle continues byte for byte, and
+    its contact statistics (summary.json's solid_diagnostics) equal the uninterrupted run's."""
+    resume_case(env, "block_3d_contact", "SIGINT")
+    ref, out = (summary(env.out(f"block_3d_contact_{n}")) for n in ("ref", "cut"))
+    d = ref["solid_diagnostics"]
+    assert out["solid_diagnostics"] == d, (out["solid_diagnostics"], d)
+    resumed_at = out["resumed_from_step"] * 0.001
+    assert d["contact_first_time"] < resumed_at and d["contact_last_time"] == 2.0, (d, resumed_at)
+    assert 0 < d["contact_min_gap"] < 0.01 and d["contact_max_force"] > 0, d
+    print(f"contact from t = {d['contact_first_time']:.3f} to the end ({d['contact_active_steps']:.0f} steps), "
+          f"smallest gap {d['contact_min_gap']:.4g}, largest force {d['contact_max_force']:.4g}; resumed at "
+          f"t = {resumed_at:.3f} in contact")
 
 
 def resume_thick_beam(env):
@@ -793,6 +815,6 @@ def full_disk(env):
 
 if __name__ == "__main__":
     main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, recover_kill_3d, resume_refused, fork,
-                                  recover_kill, recover_kill_fenics, recover_stop, recover_gives_up, exit_paths,
-                                  coupler_death, orphan_servers, vtk_output, write_failure, full_disk,
+                                  resume_contact, recover_kill, recover_kill_fenics, recover_stop, recover_gives_up,
+                                  exit_paths, coupler_death, orphan_servers, vtk_output, write_failure, full_disk,
                                   resume_external, resume_before_summary, growth)})

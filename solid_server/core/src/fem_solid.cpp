@@ -309,7 +309,10 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
       set_interface_mass(nodal_interface_mass(interface_, Eigen::VectorXd()));
   }
 
-  // 8. Probes: displacement of named points, interpolated in the cell that holds them.
+  // 8. Rigid obstacles (contact).
+  configure_obstacles(s, constants);
+
+  // 9. Probes: displacement of named points, interpolated in the cell that holds them.
   probes_.clear();
   for (const auto& p : s.list("probes")) {
     Probe probe;
@@ -341,7 +344,7 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   series_.reset();
   if (!setup.output_dir.empty() && output_every_ > 0) series_.emplace(setup.output_dir, "solid", setup.vtk_format);
 
-  // 9. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
+  // 10. Initial state: at rest, undeformed; Newmark needs a consistent a_0 = M^-1 (F - F_int).
   const int n = system_->num_dofs();
   d_n_ = v_n_ = a_n_ = f_n_ = Eigen::VectorXd::Zero(n);
   if (scheme_ == TimeScheme::Newmark) a_n_ = system_->solve_mass(dead_load_);
@@ -349,11 +352,65 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   d_nm1_ = d_n_, v_nm1_ = v_n_;
   accepted_steps_ = 0;
   solved_ = false;
+  contact_stats_ = {};
   log->info("fem solid: {}D, {} nodes, {} {} cells, {} free dofs, law {}, mu {:.6g}, lambda {:.6g}, {} analysis{}{}",
             dim, mesh_.num_nodes(), mesh_.num_cells(), element, system_->num_free(),
             dim == 2 ? material->name() : material3->name(), constants.mu, constants.lambda, analysis,
             scheme_ == TimeScheme::Static ? "" : ", scheme " + scheme,
             setup.interface_damping > 0 ? fmt::format(", interface damping {:.4g}", setup.interface_damping) : "");
+}
+
+void FemSolid::configure_obstacles(const schema::Reader& s, const ElasticConstants& constants) {
+  const int dim = mesh_.dim;
+  const double youngs = constants.mu * (3 * constants.lambda + 2 * constants.mu) / (constants.lambda + constants.mu);
+  std::vector<Obstacle> obstacles;
+  std::vector<std::vector<Facet>> per_obstacle;  // each facet once (a facet in two sets counts once)
+  const auto list = s.list("obstacles");
+  for (const auto& o : list) {
+    Obstacle obstacle;
+    obstacle.point = vec(o, "point", dim);
+    obstacle.normal = vec(o, "normal", dim);
+    if (!(obstacle.normal.norm() > 0)) o.fail("normal", "must not be zero");
+    obstacle.contact_gap = o.get<double>("contact_gap");
+    std::vector<Facet> mine;
+    try {
+      mine = mesh_.facets(o.has("boundary") ? o.names("boundary") : mesh_.facet_set_names());
+    } catch (const std::invalid_argument& e) {
+      o.fail("boundary", e.what());
+    }
+    std::vector<Facet> unique;
+    std::set<std::vector<int>> own;
+    double h = 1e300;
+    for (const auto& f : mine) {
+      std::vector<int> key = f;
+      std::sort(key.begin(), key.end());
+      if (!own.insert(key).second) continue;
+      unique.push_back(f);
+      for (std::size_t a = 0; a < f.size(); ++a)
+        h = std::min(h, (mesh_.nodes.row(f[a]) - mesh_.nodes.row(f[(a + 1) % f.size()])).norm());
+    }
+    if (unique.empty()) o.fail("boundary", "names no facets");
+    obstacle.stiffness = o.has("stiffness") ? o.get<double>("stiffness") : youngs / h;
+    obstacles.push_back(obstacle);
+    per_obstacle.push_back(std::move(unique));
+  }
+  if (obstacles.empty()) {
+    system_->set_contact(nullptr);
+    return;
+  }
+  std::shared_ptr<ObstacleContact> contact;
+  try {
+    contact = std::make_shared<ObstacleContact>(mesh_, obstacles, per_obstacle, system_->fixed());
+  } catch (const ObstacleError& e) {
+    list[static_cast<std::size_t>(e.obstacle)].fail("point", e.what());
+  }
+  for (std::size_t i = 0; i < obstacles.size(); ++i)
+    fsi::logger("solid")->info(
+        "obstacle {}: contact gap {:.4g}, stiffness {:.4g}, {} contact nodes ({} start within the gap and are left "
+        "out)",
+        i, obstacles[i].contact_gap, obstacles[i].stiffness, contact->candidates(static_cast<int>(i)),
+        contact->excluded(static_cast<int>(i)));
+  system_->set_contact(std::move(contact));
 }
 
 void FemSolid::set_interface_mass(const NodalMatrix& m) {
@@ -496,7 +553,83 @@ std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
     if (u.size() == 3) probes[p.name + "_z"] = u(2);
   }
   probes["newton_iterations"] = last_iterations_;
+  if (const ObstacleContact* contact = system_->contact()) {
+    const ContactState state = contact->measure(d_n_);
+    const bool was_active = contact_stats_.active;
+    contact_stats_.add(state, info.time, info.dt > 0 ? info.dt : setup_.dt);
+    if (contact_stats_.active != was_active)
+      fsi::logger("solid")->info(
+          "step {} (t = {:.6g}): contact {}: {} nodes below the contact gap, smallest gap {:.4g}, force {:.4g}",
+          info.step, info.time, contact_stats_.active ? "begins" : "ends", state.active_nodes, state.min_gap,
+          state.force.norm());
+  }
   return probes;
+}
+
+void ContactStatistics::add(const ContactState& s, double time, double dt) {
+  active = s.active_nodes > 0;
+  if (s.min_gap < min_gap) min_gap = s.min_gap, min_gap_time = time, min_gap_point = s.min_gap_point;
+  if (!active) return;
+  ++active_steps;
+  active_time += dt;
+  if (first_time < 0) first_time = time;
+  last_time = time;
+  if (s.force.norm() > max_force) max_force = s.force.norm(), max_force_time = time;
+  if (lower.size() == 0)
+    lower = s.lower, upper = s.upper;
+  else
+    lower = lower.cwiseMin(s.lower), upper = upper.cwiseMax(s.upper);
+}
+
+std::map<std::string, double> ContactStatistics::report() const {
+  std::map<std::string, double> r;
+  const char* axes = "xyz";
+  r["contact_active_steps"] = active_steps;
+  r["contact_active_time"] = active_time;
+  if (min_gap_time >= 0) {
+    r["contact_min_gap"] = min_gap;
+    r["contact_min_gap_time"] = min_gap_time;
+    for (Eigen::Index c = 0; c < min_gap_point.size(); ++c)
+      r[std::string("contact_min_gap_") + axes[c]] = min_gap_point(c);
+  }
+  if (active_steps == 0) return r;
+  r["contact_first_time"] = first_time;
+  r["contact_last_time"] = last_time;
+  r["contact_max_force"] = max_force;
+  r["contact_max_force_time"] = max_force_time;
+  for (Eigen::Index c = 0; c < lower.size(); ++c) {
+    r[std::string("contact_region_") + axes[c] + "_min"] = lower(c);
+    r[std::string("contact_region_") + axes[c] + "_max"] = upper(c);
+  }
+  return r;
+}
+
+void ContactStatistics::save(StateArchive& state) const {
+  // [steps, time, first, last, min gap, its time, max force, its time, active], then the points.
+  state.put("solid.contact.scalars",
+            std::vector<double>{static_cast<double>(active_steps), active_time, first_time, last_time, min_gap,
+                                min_gap_time, max_force, max_force_time, active ? 1.0 : 0.0});
+  state.put("solid.contact.min_gap_point", min_gap_point);
+  state.put("solid.contact.lower", lower);
+  state.put("solid.contact.upper", upper);
+}
+
+void ContactStatistics::load(const StateArchive& state, int dim) {
+  const Eigen::VectorXd v = state.vector("solid.contact.scalars", 9);
+  active_steps = static_cast<int>(v(0));
+  active_time = v(1), first_time = v(2), last_time = v(3), min_gap = v(4), min_gap_time = v(5);
+  max_force = v(6), max_force_time = v(7), active = v(8) != 0;
+  min_gap_point = state.vector("solid.contact.min_gap_point");
+  lower = state.vector("solid.contact.lower");
+  upper = state.vector("solid.contact.upper");
+  for (const auto* p : {&min_gap_point, &lower, &upper})
+    if (p->size() != 0 && p->size() != dim)
+      throw StateError(fmt::format("solid checkpoint: a contact point has {} components, the mesh {}", p->size(), dim));
+}
+
+std::map<std::string, double> FemSolid::diagnostics() const {
+  if (!system_ || !system_->contact()) return {};
+  return contact_stats_.report();
 }
 
 void FemSolid::save_state(StateArchive& state) {
@@ -508,6 +641,7 @@ void FemSolid::save_state(StateArchive& state) {
   state.put("solid.f_n", f_n_);
   state.put("solid.d_nm1", d_nm1_);
   state.put("solid.v_nm1", v_nm1_);
+  if (system_->contact()) contact_stats_.save(state);
 }
 
 void FemSolid::load_state(const StateArchive& state) {
@@ -523,6 +657,8 @@ void FemSolid::load_state(const StateArchive& state) {
   d_nm1_ = state.vector("solid.d_nm1", n);
   v_nm1_ = state.vector("solid.v_nm1", n);
   accepted_steps_ = static_cast<int>(state.integer("solid.accepted_steps"));
+  contact_stats_ = {};
+  if (system_->contact()) contact_stats_.load(state, mesh_.dim);
   d_ = d_n_, v_ = v_n_, a_ = a_n_, f_ = f_n_;
   solved_ = false;
 }

@@ -92,6 +92,27 @@ const std::vector<schema::Key>& fem_solid_keys() {
                        vector("force", "the load").req().in_unit("N"),
                    })
           .def("[]"),
+      section_list(
+          "obstacles",
+          "rigid obstacles (half-planes in 2D, half-spaces in 3D): the boundary keeps a layer of about contact_gap "
+          "from each (a smooth penalty, p = k_n (g_c - g)^2 / g_c below g_c). Nodes that start within contact_gap "
+          "(next to a clamp on the obstacle) and clamped nodes are left out",
+          {
+              vector("point", "a point of the obstacle's surface").req().in_unit("m"),
+              vector("normal", "the surface's normal out of the obstacle, towards the solid (any length > 0)").req(),
+              number("contact_gap",
+                     "g_c: the pressure acts below this gap; about one fluid cell at the wall, so the fluid keeps "
+                     "a layer there (thin_beam: hl = 0.008)")
+                  .req()
+                  .gt(0)
+                  .in_unit("m"),
+              number("stiffness", "k_n: the pressure per gap below g_c (p(0) = k_n g_c)")
+                  .gt(0)
+                  .def_computed("E / h, h the shortest edge of the contact facets")
+                  .in_unit("Pa/m"),
+              names("boundary", "facet set(s) that may touch it").def_computed("every facet set of the mesh"),
+          })
+          .def("[]"),
       section_list("probes", "displacement of points (probes NAME_x, NAME_y, and NAME_z in 3D)",
                    {
                        text("name", "probe name").req(),

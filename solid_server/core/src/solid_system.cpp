@@ -297,6 +297,7 @@ Eigen::VectorXd SolidSystem::residual(const Eigen::VectorXd& d, const Eigen::Vec
     r += mass_ * time_vector(t.mass_coefficient, d, t.acceleration_history);
   if (damping_.nonZeros() && (t.damping_coefficient != 0 || t.velocity_history.size()))
     r += damping_ * time_vector(t.damping_coefficient, d, t.velocity_history);
+  if (contact_) contact_->add_to_residual(d, r);
   return r;
 }
 
@@ -332,6 +333,12 @@ void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ex
     r += mass_ * time_vector(t.mass_coefficient, d, t.acceleration_history);
   if (t.damping_coefficient != 0 || t.velocity_history.size())
     r += damping_ * time_vector(t.damping_coefficient, d, t.velocity_history);
+  if (contact_) {
+    contact_->add_to_residual(d, r);
+    contact_->add_to_tangent(d, [&](int row, int col, double value) {
+      if (equation_[row] >= 0 && equation_[col] >= 0) values[full_to_reduced_[position(row, col)]] += value;
+    });
+  }
   r_free.resize(num_free());
   for (int i = 0; i < num_free(); ++i) r_free(i) = r(free_dofs_[i]);
 }

@@ -149,6 +149,9 @@ class SolidModel : public IterationReporting {
   virtual std::map<std::string, double> timings() const { return {}; }
   // Problem size for summary.json after configure() (e.g. "dofs", "nodes", "elements").
   virtual std::map<std::string, double> sizes() const { return {}; }
+  // Statistics of the run so far, after accept_step(), for summary.json's "solid_diagnostics"
+  // (e.g. contact: how long, where, the smallest gap). Part of the checkpointed state. Optional.
+  virtual std::map<std::string, double> diagnostics() const { return {}; }
   // Checkpoints: the state after the last accepted step; see the call order above.
   virtual bool supports_checkpoint() const { return false; }
   virtual void save_state(StateArchive& /*state*/) { unsupported_checkpoint(name()); }
@@ -195,6 +198,8 @@ class FluidModel : public IterationReporting {
   virtual FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                 const Eigen::VectorXd& interface_velocity) = 0;
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
+  // Statistics of the run so far (summary.json's "fluid_diagnostics"); see SolidModel. Optional.
+  virtual std::map<std::string, double> diagnostics() const { return {}; }
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
   // False: write_output() is never called (a remote server without supports_output).
   virtual bool supports_output() const { return true; }

@@ -27,6 +27,7 @@ class RemoteSolid : public SolidModel {
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
+  std::map<std::string, double> diagnostics() const override { return diagnostics_; }
   bool supports_checkpoint() const override { return supports_checkpoint_; }
   bool supports_output() const override { return supports_output_; }
   std::string save_checkpoint(int step, double time) override;
@@ -37,6 +38,7 @@ class RemoteSolid : public SolidModel {
 
  private:
   std::map<std::string, double> timings_;
+  std::map<std::string, double> diagnostics_;
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "solid server";
   bool supports_damping_ = false;
@@ -59,6 +61,7 @@ class RemoteFluid : public FluidModel {
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
+  std::map<std::string, double> diagnostics() const override { return diagnostics_; }
   bool supports_checkpoint() const override { return supports_checkpoint_; }
   bool supports_output() const override { return supports_output_; }
   std::string save_checkpoint(int step, double time) override;
@@ -69,6 +72,7 @@ class RemoteFluid : public FluidModel {
 
  private:
   std::map<std::string, double> timings_;
+  std::map<std::string, double> diagnostics_;
   std::unique_ptr<ProtocolClient> client_;
   std::string server_name_ = "fluid server";
   bool supports_checkpoint_ = false;

@@ -27,9 +27,30 @@
 #include "fsi/common/vtk_writer.hpp"
 #include "fsi/solid/solid_system.hpp"
 
+namespace fsi::schema {
+class Reader;
+}
+
 namespace fsi::solid {
 
 enum class TimeScheme { Static, Bdf1, Bdf2, Newmark };
+
+// Contact with the scene's obstacles over the accepted steps (what summary.json reports).
+struct ContactStatistics {
+  int active_steps = 0;
+  double active_time = 0;                     // sum of dt over the steps with contact
+  double first_time = -1, last_time = -1;     // first and last step with contact (-1: none)
+  double min_gap = 1e300, min_gap_time = -1;  // smallest gap of any accepted step
+  Eigen::VectorXd min_gap_point;              // where
+  double max_force = 0, max_force_time = -1;  // largest |total contact force|
+  Eigen::VectorXd lower, upper;               // bounding box of every active node (empty: none)
+  bool active = false;                        // at the last accepted step
+  // Adds an accepted step's state.
+  void add(const ContactState& s, double time, double dt);
+  std::map<std::string, double> report() const;
+  void save(StateArchive& state) const;
+  void load(const StateArchive& state, int dim);
+};
 
 struct Probe {
   std::string name;
@@ -58,6 +79,9 @@ class FemSolid : public fsi::SolidModel {
   void set_interface_mass(const NodalMatrix& m) override;
   void save_state(StateArchive& state) override;
   void load_state(const StateArchive& state) override;
+  // Contact statistics ("contact_*") when the scene declares obstacles.
+  std::map<std::string, double> diagnostics() const override;
+  const ContactStatistics& contact_statistics() const { return contact_stats_; }
 
   // State access (tests, benchmarks).
   const SolidSystem& system() const { return *system_; }
@@ -73,6 +97,7 @@ class FemSolid : public fsi::SolidModel {
  private:
   Eigen::VectorXd external_force(const Eigen::VectorXd& interface_force) const;
   void newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTerms& t, const StepInfo& info);
+  void configure_obstacles(const schema::Reader& s, const ElasticConstants& constants);
 
   SolidMesh mesh_;
   std::unique_ptr<SolidSystem> system_;
@@ -93,6 +118,7 @@ class FemSolid : public fsi::SolidModel {
   Eigen::VectorXd d_, v_, a_, f_;
   int last_iterations_ = 0;
   bool solved_ = false;
+  ContactStatistics contact_stats_;
 };
 
 }  // namespace fsi::solid
