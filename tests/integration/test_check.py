@@ -156,8 +156,8 @@ def obstacles():
     with tempfile.TemporaryDirectory() as tmp:
         scene = edited(tmp, "thin_beam.yaml", [("contact_gap: 0.008", "contact_gap: -0.008, stiffness: -1")])
         expect(["check", scene], 1, "",
-               f"{place(scene, 'contact_gap')}: 'solid.obstacles[0].contact_gap' must be > 0, got '-0.008'\n"
-               f"{place(scene, 'stiffness')}: 'solid.obstacles[0].stiffness' must be > 0, got '-1'\n")
+               f"{place(scene, 'contact_gap')}: 'solid.obstacles[0].contact_gap' must be positive, got '-0.008'\n"
+               f"{place(scene, 'stiffness')}: 'solid.obstacles[0].stiffness' must be positive, got '-1'\n")
     expect(["check", "configs/sdof_model.yaml", "--set",
             "solid.obstacles=[{point: [0, 0], normal: [0, 1], contact_gap: 0.01}]"], 1, "",
            "configs/sdof_model.yaml (--set solid.obstacles=[{point: [0, 0], normal: [0, 1], contact_gap: 0.01}]): "
