@@ -158,6 +158,10 @@ def obstacles():
         expect(["check", scene], 1, "",
                f"{place(scene, 'contact_gap')}: 'solid.obstacles[0].contact_gap' must be positive, got '-0.008'\n"
                f"{place(scene, 'stiffness')}: 'solid.obstacles[0].stiffness' must be positive, got '-1'\n")
+        scene = edited(tmp, "sdof_model.yaml", [("  mass: 1.0 ", "  obstacles: [{point: [0, 0], normal: [0, 1], "
+                                                 "contact_gap: 0.01}]\n  mass: 1.0 ")])
+        expect(["check", scene], 1, "", f"{place(scene, 'obstacles')}: unknown key 'solid.obstacles' for solid.model "
+               "'sdof' (it is a key of solid.model 'fem')\n")
     expect(["check", "configs/sdof_model.yaml", "--set",
             "solid.obstacles=[{point: [0, 0], normal: [0, 1], contact_gap: 0.01}]"], 1, "",
            "configs/sdof_model.yaml (--set solid.obstacles=[{point: [0, 0], normal: [0, 1], contact_gap: 0.01}]): "
