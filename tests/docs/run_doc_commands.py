@@ -150,6 +150,13 @@ SKIP = {
     "coupling.iterations.max=2 --set coupling.gamma_n1=G": "synopsis (G = 10, 100, 1000): benchmarks of up to 2 minutes",
     "/usr/bin/python3 bench/fsi/thin_beam_remesh_plot.py docs/img/thin_beam_A_x_remesh.png \"Algorithm 1, gamma "
     "100=runs/thin_a1\" \"Algorithm 2, gamma 10=runs/thin_a2_g10\" ...": "synopsis; reads the thin-beam runs (benchmarks)",
+    # docs/paper_examples.md (the thin beam with the channel wall as a contact obstacle).
+    "build/bin/fsi run configs/thin_beam.yaml --out runs/thin_ref": "benchmark: the thin beam's reference, about 180 s",
+    "/usr/bin/python3 bench/fsi/thin_beam_contact_table.py runs/thin_ref \"A2 g100=runs/thin_a2_g100\" ... --pair "
+    "\"A2 g100,A2 g100 gc/2\" ...": "synopsis; reads the thin-beam runs (benchmarks)",
+    "/usr/bin/python3 bench/fsi/thin_beam_remesh_plot.py docs/img/thin_beam_A_x_contact.png \"reference (Algorithm "
+    "1, k_max 10)=runs/thin_ref\" \"Algorithm 2, gamma 100=runs/thin_a2_g100\" ...":
+        "synopsis; reads the thin-beam runs (benchmarks)",
     "bench/fsi/run_turek_hron.sh fsi2 runs/fsi2": "benchmark: Turek-Hron FSI2, 708 s",
     FSI3_B: "benchmark: FSI3 to t = 3.5",
     "/usr/bin/python3 bench/fsi/th_stats.py fsi3 runs/fsi3_B --periods 4 --plot docs/img/fsi_fsi3.png":
