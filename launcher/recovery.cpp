@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fsi/common/log.hpp"
+#include "fsi/common/run_report.hpp"
 #include "run_folder.hpp"
 
 namespace fs = std::filesystem;
@@ -117,15 +118,22 @@ Ending run_with_recovery(const RunOptions& o, CoupledProcesses& p, int recover, 
   return e;
 }
 
-void after_coupler(CoupledProcesses& p, Ending& e) {
+void after_coupler(const fs::path& out, int checkpoint_every, CoupledProcesses& p, Ending& e) {
   auto log = fsi::logger("fsi");
   if (e.code > 128 && e.code != 130) {
-    // The coupler itself died: say so at once, stop both servers together.
+    // The coupler itself died: say so at once, stop both servers together. What a resume can do
+    // depends on what the run wrote: the one that holds is said.
+    const nlohmann::json checkpoint = newest_checkpoint(out);
+    const std::string then =
+        checkpoint.is_object()  ? fmt::format("`fsi run ... --resume` continues from the checkpoint of step {}",
+                                              checkpoint.value("step", 0))
+        : checkpoint_every == 0 ? std::string("no checkpoint to continue from (time.checkpoint_every: 0)")
+                                : fmt::format(
+                                      "no checkpoint to continue from: it died after {} steps, before its first "
+                                      "(time.checkpoint_every: {})",
+                                      fsi::csv_rows(out / "probes.csv"), checkpoint_every);
     e.status = "failed";
-    e.reason = fmt::format(
-        "the coupler was killed by {} ({}); `fsi run ... --resume` continues from the last "
-        "checkpoint",
-        signal_name(e.code - 128), e.code - 128);
+    e.reason = fmt::format("the coupler was killed by {} ({}); {}", signal_name(e.code - 128), e.code - 128, then);
     log->error("{}", e.reason);
     stop_all({&p.children[0], &p.children[1]}, std::chrono::milliseconds(0), std::chrono::milliseconds(400));
     e.code = 1;

@@ -25,8 +25,9 @@ void start_servers(const RunOptions& o, const std::filesystem::path& ports, Coup
 // is started again and the run resumes from the last checkpoint, up to `recover` times.
 Ending run_with_recovery(const RunOptions& o, CoupledProcesses& p, int recover, const std::vector<std::string>& sets);
 
-// After the coupler: a coupler killed by a signal stops both servers at once; a server that
-// failed on its own shows its log.
-void after_coupler(CoupledProcesses& p, Ending& e);
+// After the coupler: a coupler killed by a signal stops both servers at once (the reason says
+// whether and from which checkpoint of `out` the run can be continued); a server that failed on
+// its own shows its log.
+void after_coupler(const std::filesystem::path& out, int checkpoint_every, CoupledProcesses& p, Ending& e);
 
 }  // namespace fsi::launcher

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <tuple>
@@ -19,6 +20,67 @@ namespace fsi::launcher {
 namespace {
 
 const char* const kCommandsFile = "commands.json";
+
+// A table a resumed run continues (the coupler cuts it back to the checkpoint's step): "" when
+// it has its header and at least `needed` complete rows of the header's width, else what is wrong.
+std::string table_problem(const fs::path& file, std::size_t needed) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return fmt::format("{} is missing", file.string());
+  std::string header;
+  if (!std::getline(in, header) || header.empty()) return fmt::format("{} has no header", file.string());
+  const auto fields = [](const std::string& line) { return std::count(line.begin(), line.end(), ',') + 1; };
+  std::size_t rows = 0;
+  for (std::string line; rows < needed && std::getline(in, line);) {
+    if (in.eof()) break;  // a row cut short (no newline): not complete
+    if (fields(line) != fields(header))
+      return fmt::format("{} line {} has {} fields, its header {}", file.string(), rows + 2, fields(line),
+                         fields(header));
+    ++rows;
+  }
+  if (rows < needed)
+    return fmt::format("{} has {} complete rows, the checkpoint needs {}", file.string(), rows, needed);
+  return "";
+}
+
+// Why a run folder without a complete checkpoint cannot be continued, from what the run wrote: its
+// time.checkpoint_every (summary.json's parameters) and how far it got. The one cause that holds.
+std::string why_no_checkpoint(const fs::path& out, const std::vector<std::string>& skipped) {
+  if (fs::is_directory(out / "checkpoints") && !skipped.empty())
+    return "no complete checkpoint in " + (out / "checkpoints").string() + " (" + skipped.front() + ")";
+  // The run's effective scene (summary.json's parameters, JSON being YAML) with the declared defaults.
+  std::optional<int> every;
+  try {
+    const auto summary = read_json(out / "summary.json");
+    if (summary.is_object() && summary.contains("parameters"))
+      every = fsi::read_time(fsi::Scene::parse(summary["parameters"].dump(), (out / "summary.json").string()))
+                  .checkpoint_every;
+  } catch (const std::exception&) {  // not readable: the cause is not known
+  }
+  const std::string then = "so it cannot be continued; run it again into another --out, or with --force";
+  if (every && *every == 0)
+    return "the run wrote no checkpoints: it was started with time.checkpoint_every: 0, " + then;
+  if (every)
+    return fmt::format(
+        "the run wrote no checkpoints: it stopped after {} steps, before its first checkpoint "
+        "(time.checkpoint_every: {}), {}",
+        fsi::csv_rows(out / "probes.csv"), *every, then);
+  return "the run wrote no checkpoints (its summary.json does not say its time.checkpoint_every), " + then;
+}
+
+// The tables the resumed run continues from checkpoint `ckpt` (a forked run's hold only the steps
+// after its fork; a resume at the fork itself starts them afresh): "" when each is whole.
+std::string tables_problem(const fs::path& out, const fsi::coupling::CheckpointStore::Loaded& ckpt) {
+  const auto fork = read_json(out / "forked_from.json");
+  const int fork_step = fork.is_object() ? fork.value("step", 0) : 0;
+  const long fork_iterations = fork.is_object() ? fork.value("iterations", 0L) : 0L;
+  if (fork.is_object() && ckpt.step == fork_step) return "";
+  const auto steps = static_cast<std::size_t>(ckpt.step - fork_step);
+  const auto iterations = static_cast<std::size_t>(ckpt.manifest.value("iterations", 0L) - fork_iterations);
+  std::string problem = table_problem(out / "probes.csv", steps);
+  if (problem.empty()) problem = table_problem(out / "iterations.csv", iterations);
+  if (problem.empty() && fs::exists(out / "timing.csv")) problem = table_problem(out / "timing.csv", steps);
+  return problem.empty() ? "" : fmt::format("{} (checkpoint of step {})", problem, ckpt.step);
+}
 
 }  // namespace
 
@@ -106,12 +168,7 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
   const auto ckpt = fsi::coupling::CheckpointStore(out / "checkpoints", 1).newest(&skipped);
   // A run killed as a whole before its first summary.json: its complete checkpoints prove it.
   if (!fs::exists(out / "summary.json") && !ckpt) refuse("not a run folder (no summary.json, no checkpoint)");
-  if (!ckpt)
-    refuse(fs::is_directory(out / "checkpoints")
-               ? "no complete checkpoint in " + (out / "checkpoints").string() +
-                     (skipped.empty() ? std::string() : " (" + skipped.front() + ")")
-               : "the run wrote no checkpoints (time.checkpoint_every is 0, or the run stopped before its first "
-                 "checkpoint), so it cannot be continued; run it again into another --out, or with --force");
+  if (!ckpt) refuse(why_no_checkpoint(out, skipped));
   std::vector<std::string> overrides;
   for (const auto& ov : ckpt->manifest.value("overrides", nlohmann::json::array()))
     overrides.push_back(ov.get<std::string>());
@@ -153,6 +210,10 @@ std::optional<std::vector<std::string>> prepare_resume(const RunOptions& o) {
         o.out_dir, end);
     return std::nullopt;
   }
+  // The tables before anything is touched: a damaged one is refused here, not by the coupler after
+  // summary.json and the logs have been written.
+  if (const std::string problem = tables_problem(out, *ckpt); !problem.empty())
+    refuse(problem + ": the run cannot be continued from it");
   if (extended)
     fsi::logger("fsi")->info("extending the run to time.end = {} from the checkpoint of step {} (t = {})", end,
                              ckpt->step, ckpt->time);

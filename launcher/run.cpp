@@ -78,7 +78,7 @@ int run_coupled(const RunOptions& o, const fsi::Scene& scene, const std::vector<
       log->warn("--recover without checkpoints (time.checkpoint_every: 0): a recovered run starts again from step 0");
     start_servers(o, ports, p, fluid_mpi_launcher(scene));
     e = run_with_recovery(o, p, recover, sets);
-    after_coupler(p, e);
+    after_coupler(out, every, p, e);
   } catch (const std::exception& ex) {
     log->error("{}", ex.what());
     e = {g_signal ? 130 : 1, g_signal ? "interrupted" : "failed", ex.what()};
