@@ -12,6 +12,12 @@
 // Exit codes: 0 completed, 2 diverged, 1 failed (bad input or options, a dead peer that could
 // not be recovered, a crashed coupler), 130 interrupted (SIGINT / SIGTERM). Every way a run
 // ends leaves summary.json with its final status.
+//
+// This file is the command line and its dispatch. The run: run.cpp (a scene checked, then one
+// solver alone or the coupled processes), processes.cpp (starting and stopping them, signals),
+// recovery.cpp (a coupled run's servers and their recovery), resume.cpp (--resume, extension,
+// --from), run_folder.cpp (summary.json, the newest checkpoint); check.cpp (fsi check),
+// final_values.cpp (the final values at the end), python_tools.cpp (fsi plot, study, list).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
