@@ -1,11 +1,8 @@
 #include "final_values.hpp"
 
 #include <fmt/format.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -76,35 +73,6 @@ void report_final_values(const fs::path& out) {
   } catch (const std::exception& e) {
     logger("fsi")->warn("final values of {}: {}", out.string(), e.what());
   }
-}
-
-int plot_folder(const fs::path& folder, const std::string& python, const fs::path& self_dir, bool quiet) {
-  // An installed fsi (PREFIX/bin) uses PREFIX/share/fsi/tools, a build tree its sources.
-  fs::path tool = (self_dir / ".." / "share" / "fsi" / "tools" / "fsi_plot.py").lexically_normal();
-#ifdef FSI_SOURCE_DIR
-  if (!fs::exists(tool)) tool = fs::path(FSI_SOURCE_DIR) / "tools" / "fsi_plot.py";
-#endif
-  if (!fs::exists(tool)) {
-    logger("fsi")->error("plot tool not found: {}", tool.string());
-    return 1;
-  }
-  std::vector<std::string> args{python, tool.string(), folder.string()};
-  if (quiet) args.push_back("--quiet");
-  const pid_t pid = fork();
-  if (pid < 0) return 1;
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execvp(argv[0], argv.data());
-    std::fprintf(stderr, "cannot start %s (set FSI_PYTHON to a python3 with numpy and matplotlib): %s\n", argv[0],
-                 std::strerror(errno));
-    _exit(127);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
 }  // namespace fsi::launcher

@@ -8,6 +8,7 @@
 // options), 130 interrupted (SIGINT/SIGTERM); with --recoverable, 75 when a server died or
 // stopped answering (the launcher restarts it and resumes from the last checkpoint).
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -200,6 +201,19 @@ void run_coupled(const Options& o, const fsi::Scene& scene, fsi::RunReport& repo
   }
 }
 
+// The process that started the coupler (fsi run) ended while the run had not: the servers it
+// started ended with it (their parent-death signal), and so may the coupler (the same signal). A
+// server lost now is not a failure of its own: the run was stopped with its launcher. The outcome
+// says so (interrupted, no lost server), whatever the coupler noticed first.
+void launcher_gone(pid_t parent, fsi::coupling::RunOutcome& outcome) {
+  if (parent <= 1 || getppid() == parent || outcome.status == "completed" || outcome.status == "diverged") return;
+  outcome.status = "interrupted";
+  outcome.reason = fmt::format(
+      "the launcher (pid {}) ended at step {} (stopped or killed); the servers it started ended with it, the run "
+      "with them",
+      parent, outcome.steps + 1);
+}
+
 // The final summary.json: the resume, a lost server, the status. A server that died or
 // stopped answering with --recoverable: the survivor is left running and the launcher told
 // which one to restart (returns 75); else returns -1.
@@ -255,6 +269,7 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   auto log = fsi::logger("coupler");
+  const pid_t parent = getppid();  // fsi run, when it started the coupler
 
   // 2. Load the scene; the report exists from here on, whatever happens.
   std::unique_ptr<fsi::Scene> scene;
@@ -282,6 +297,7 @@ int main(int argc, char** argv) {
 
   // 3. Connect (handshake), run, write the summary, stop the servers.
   run_coupled(o, *scene, report, servers, outcome, start, log);
+  launcher_gone(parent, outcome);
   const int code = write_summary(o, report, servers, outcome, start, log);
   if (code >= 0) return code;
   if (code == -2) outcome.write_failed = true;

@@ -49,12 +49,46 @@ def refused_unchanged(out, args, expected_text, expected_code=1):
     after = snapshot(out)
     assert before == after, f"the folder changed: {sorted(set(before.items()) ^ set(after.items()))}"
     print(f"refused ({expected_text!r}); {len(before)} files byte-identical")
+    return text
 
 
 def resume_without_checkpoints(tmp):
+    """The one cause, read from the run: checkpoints were off (not "or it stopped before its first")."""
     out = os.path.join(tmp, "run")
     run_ok(SCENE, "--out", out)
-    refused_unchanged(out, [SCENE, "--out", out, "--resume"], "wrote no checkpoints")
+    text = refused_unchanged(out, [SCENE, "--out", out, "--resume"],
+                             "wrote no checkpoints: it was started with time.checkpoint_every: 0")
+    assert "before its first" not in text, text
+
+
+def damaged_tables(tmp):
+    """A resume or an extension whose probes.csv (or iterations.csv) lacks rows up to the checkpoint, or
+    has a damaged row, is refused before anything is written: exit 1, the file named, every file of the
+    folder byte-identical (summary.json, the logs, commands.json included)."""
+    out = os.path.join(tmp, "run")
+    run_ok(SCENE, "--out", out, "--set", "time.checkpoint_every=50", "--set", "time.end=4")  # 200 steps
+    probes = os.path.join(out, "probes.csv")
+    with open(probes) as f:
+        lines = f.readlines()
+    assert len(lines) == 201, len(lines)
+    with open(probes, "w") as f:  # cut back to 120 rows: the checkpoint of step 200 needs 200
+        f.writelines(lines[:121])
+    extend = [SCENE, "--out", out, "--resume", "--set", "time.end=6"]
+    refused_unchanged(out, extend, "probes.csv has 120 complete rows, the checkpoint needs 200")
+    with open(probes, "w") as f:  # every row, one of them cut short
+        f.writelines(lines[:60] + [lines[60].split(",")[0] + "\n"] + lines[61:])
+    refused_unchanged(out, extend, "probes.csv line 61 has 1 fields")
+    with open(probes, "w") as f:
+        f.writelines(lines)
+    iterations = os.path.join(out, "iterations.csv")
+    with open(iterations) as f:
+        kept = f.readlines()
+    with open(iterations, "w") as f:
+        f.writelines(kept[:10])
+    refused_unchanged(out, extend, "iterations.csv has 9 complete rows")
+    with open(iterations, "w") as f:
+        f.writelines(kept)
+    run_ok(*extend)  # the repaired folder extends
 
 
 def resume_mismatched_scene(tmp):
@@ -144,7 +178,7 @@ def study_invalid_case(tmp):
     print(f"refused before running (exit {code})")
 
 
-CASES = {"study_invalid_case": study_invalid_case, "resume_without_checkpoints": resume_without_checkpoints, "resume_mismatched_scene": resume_mismatched_scene,
+CASES = {"damaged_tables": damaged_tables, "study_invalid_case": study_invalid_case, "resume_without_checkpoints": resume_without_checkpoints, "resume_mismatched_scene": resume_mismatched_scene,
          "invalid_scene": invalid_scene, "extend": extend, "configure_error": configure_error}
 
 

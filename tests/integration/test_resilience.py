@@ -631,6 +631,46 @@ def coupler_death(env):
     print(f"coupler killed: launcher ended in {elapsed:.2f} s; resumed and completed")
 
 
+def coupler_death_before_checkpoint(env):
+    """kill -9 of the coupler before the run's first checkpoint: the reason says that there is no
+    checkpoint and why (not that --resume continues), and --resume is refused with that one cause."""
+    out = env.out("death_before_checkpoint")
+    p = launch(env, "sdof_model.yaml", out, ["time.end=60", "time.checkpoint_every=100000"])
+    wait_rows(os.path.join(out, "probes.csv"), 50, p, 20)
+    process_named(out, "coupler").kill()
+    code, log = finish(p, 10)
+    s = assert_final(out, "failed", 1, code)
+    assert "SIGKILL" in s["reason"] and "before its first (time.checkpoint_every: 100000)" in s["reason"], s["reason"]
+    assert "--resume" not in s["reason"] and "continue it with" not in log, (s["reason"], log[-800:])
+    assert_no_leftovers(out)
+    code, log = finish(launch(env, "sdof_model.yaml", out, [], ("--resume",)), 30)
+    assert code == 1, (code, log[-800:])
+    assert "before its first checkpoint (time.checkpoint_every: 100000)" in log, log[-800:]
+    assert "checkpoint_every is 0" not in log and "checkpoint_every: 0" not in log, log[-800:]
+    print(f"coupler killed before its first checkpoint: {s['reason']}")
+
+
+def launcher_killed(env):
+    """kill -9 of the launcher alone (not its group): its servers and the coupler end with it, and the
+    run's summary.json says the launcher ended (interrupted), not that a server died; --resume
+    continues the run to the end. Three kills at different steps."""
+    sets = ["time.end=5", "time.checkpoint_every=100"]
+    for at in (120, 250, 380):
+        out = env.out(f"launcher_killed_{at}")
+        p = launch(env, "added_mass.yaml", out, sets)
+        wait_rows(os.path.join(out, "probes.csv"), at, p, 60)
+        p.kill()  # the launcher only: its children are in their own process groups
+        p.wait(timeout=5)
+        assert_no_leftovers(out, timeout=10)
+        s = assert_final(out, "interrupted")
+        assert "the launcher" in s["reason"] and "lost_peer" not in s and "closed the connection" not in s["reason"], s
+        print(f"launcher killed at row {at}: {s['reason']}")
+    code, log = finish(launch(env, "added_mass.yaml", out, [], ("--resume",)), 60)
+    assert code == 0, log[-1500:]
+    assert_final(out, "completed")
+    print("the last one resumed and completed")
+
+
 def orphan_servers(env):
     """Servers started by the launcher exit when the launcher itself is killed."""
     out = env.out("orphans")
@@ -816,5 +856,6 @@ def full_disk(env):
 if __name__ == "__main__":
     main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, recover_kill_3d, resume_refused, fork,
                                   resume_contact, recover_kill, recover_kill_fenics, recover_stop, recover_gives_up,
-                                  exit_paths, coupler_death, orphan_servers, vtk_output, write_failure, full_disk,
+                                  exit_paths, coupler_death, coupler_death_before_checkpoint, launcher_killed,
+                                  orphan_servers, vtk_output, write_failure, full_disk,
                                   resume_external, resume_before_summary, growth)})
