@@ -5,8 +5,12 @@
 //   build/bin/solid_bench run configs/csm3.yaml                      # dynamic: mean/amplitude/frequency
 //   build/bin/solid_bench run configs/csm3.yaml solid.time_scheme=bdf1
 //   build/bin/solid_bench timing [cholmod|umfpack]                   # Newton iteration / step timings
+//   build/bin/solid_bench phases configs/cantilever_strip_3d.yaml "solid.mesh.divisions=[64, 8, 32]"
+//       # one Newton iteration by phases (assembly, factorisation, solve), peak memory: JSON
 // Extra arguments key=value override scene keys (as the solid_server's --set).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <sys/resource.h>
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -170,6 +174,53 @@ solid:
   return 0;
 }
 
+// One Newton iteration of a scene's solid at rest, by phases, `repeats` times: the assembly
+// of the tangent and residual, the factorisation (CHOLMOD's symbolic analysis is in the
+// first one only: reported apart), the solve; the peak resident memory of the process. One
+// JSON line (bench/solid/phases_3d.py reads it).
+int phases(const std::string& scene_file, const std::vector<std::string>& overrides, int repeats = 4) {
+  auto scene = fsi::Scene::load(scene_file, overrides);
+  auto time = scene.section("time");
+  fsi::SolidSetup setup;
+  setup.dt = time.get<double>("dt");
+  setup.end_time = time.get<double>("end");
+  fsi::solid::FemSolid solid;
+  auto t = Clock::now();
+  auto lap = [&t] {
+    const auto now = Clock::now();
+    const double s = std::chrono::duration<double>(now - t).count();
+    t = now;
+    return s;
+  };
+  solid.configure(scene.section("solid"), setup);
+  const double setup_s = lap();
+  auto& sys = solid.system();
+  const Eigen::VectorXd d = Eigen::VectorXd::Zero(sys.num_dofs()), f = Eigen::VectorXd::Ones(sys.num_dofs());
+  fsi::solid::SparseMatrix K;
+  Eigen::VectorXd r;
+  std::vector<double> assembly, factorisation, solve;
+  double check = 0;
+  for (int k = 0; k < repeats; ++k) {
+    lap();
+    sys.assemble(d, f, fsi::solid::TimeTerms{}, K, r);
+    assembly.push_back(lap());
+    sys.linear_solver().factorize(K);
+    factorisation.push_back(lap());
+    const Eigen::VectorXd x = sys.linear_solver().solve(r);
+    solve.push_back(lap());
+    check = (K * x - r).norm() / r.norm();
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto list = [](const std::vector<double>& v) { return fmt::format("{:.6f}", fmt::join(v, ", ")); };
+  fmt::print(
+      "{{\"solver\": \"solid_server\", \"free_dofs\": {}, \"nonzeros\": {}, \"setup\": {:.6f}, \"assembly\": [{}], "
+      "\"factorisation\": [{}], \"solve\": [{}], \"relative_residual\": {:.3e}, \"peak_rss_mb\": {:.1f}}}\n",
+      sys.num_free(), K.nonZeros(), setup_s, list(assembly), list(factorisation), list(solve), check,
+      usage.ru_maxrss / 1024.0);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -181,7 +232,10 @@ int main(int argc, char** argv) {
     }
     if (mode == "run" && argc > 2) return run(argv[2], std::vector<std::string>(argv + 3, argv + argc));
     if (mode == "timing") return timing(argc > 2 ? argv[2] : "cholmod");
-    std::fprintf(stderr, "usage: solid_bench run SCENE [key=value ...] | solid_bench timing [cholmod|umfpack]\n");
+    if (mode == "phases" && argc > 2) return phases(argv[2], std::vector<std::string>(argv + 3, argv + argc));
+    std::fprintf(stderr,
+                 "usage: solid_bench run SCENE [key=value ...] | solid_bench timing [cholmod|umfpack] | "
+                 "solid_bench phases SCENE [key=value ...]\n");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -120,6 +120,8 @@ SKIP = {
     "docker compose -f docker/compose.study.yaml up -d --build --scale worker=2": "Docker: no engine in CI",
     "docker compose -f docker/compose.study.yaml down": "Docker: no engine in CI",
     "/usr/bin/python3 bench/studies/dask_scaling.py --out /tmp/fsi_dask_scaling": "benchmark (scaling over workers)",
+    "/usr/bin/python3 bench/solid/phases_3d.py --bin build/bin --runs 3 --repeats 3 --divisions 64 8 32":
+        "benchmark: 57k-dof solids by phases, FEniCS's SuperLU about a minute per factorisation, 12 minutes",
     "build/bin/fsi study studies/extreme_sdof.yaml --out runs/study_extreme":
         "1440 runs, about 3 minutes on 2 cores; its CI cut is ctest study.extreme_ci",
     "python3 bench/fluid/periodic_stats.py out/dfg_2d2/probes.csv --columns fluid.cd fluid.cl fluid.dp --window 1.0 "

@@ -119,6 +119,37 @@ def beta_limit(algorithm, gamma, m, c, k, m_a, dt, measure=1.0):
     return 2 * (m_eff + (gamma * measure * dt if algorithm == 2 else 0.0)) / (m_eff + m_a)
 
 
+def monolithic_added_mass(steps, dt=0.01, m=1.0, m_a=10.0, c=0.5, k=4.0, F=1.0):
+    """The monolithic BDF1 solution of (m + m_a) a + c v + k d = F from rest: what every
+    converged coupling of the added-mass problem must give."""
+    d = v = 0.0
+    out = []
+    M = m + m_a
+    for _ in range(steps):
+        dn = (F + M * (d / (dt * dt) + v / dt) + c * d / dt) / (M / (dt * dt) + c / dt + k)
+        v = (dn - d) / dt
+        d = dn
+        out.append(d)
+    return out
+
+
+def loosely_coupled_added_mass(parallel, m, m_a, G, dt, steps):
+    """One iteration per step (beta 1, predictor F_n), c = k = 0, Algorithm 2 with the solid's
+    damping G / dt (G = gamma |Gamma| dt; coupling.robin_auto=solid: G = m): the solid's
+    displacement step by step, serial (the fluid sees the new velocity) or parallel (the old)."""
+    d = v = v_fluid = 0.0
+    force = 1.0
+    out = []
+    for _ in range(steps):
+        dn = (force + m * (d / (dt * dt) + v / dt) + G / dt * d / dt) / (m / (dt * dt) + G / dt / dt)
+        vn = (dn - d) / dt
+        v_in = v if parallel else vn
+        force = 1 - m_a * (v_in - v_fluid) / dt + G / dt * v_in
+        v_fluid, d, v = v_in, dn, vn
+        out.append(d)
+    return out
+
+
 def main(cases):
     env = Env(sys.argv[1:])
     try:

@@ -10,7 +10,7 @@ import time
 
 import zmq
 
-from harness import beta_limit, main, probes, recurrence, summary
+from harness import beta_limit, loosely_coupled_added_mass, main, monolithic_added_mass, probes, recurrence, summary
 
 
 def end_to_end(env):
@@ -285,6 +285,66 @@ def added_mass(env):
               f"({s['reason'][:60]}...)")
 
 
+def options_3d(env):
+    """The coupling options on the non-matching 3D plates of sdof_3d.yaml (area 1, the force
+    along z) over loopback, against closed forms: the appendix problem iterated to convergence
+    with IQN-IMVJ (Algorithm 2, gamma 10: the monolithic recurrence, gamma cancelling); the added-mass problem (m 1, m_a 10, beta 0.5, above the constant
+    relaxation limit) converged by IQN-IMVJ, serial, and by the parallel scheme with IQN-ILS
+    and IQN-IMVJ, to its monolithic BDF1 solution; coupling.robin_auto loosely coupled, serial
+    and parallel, step by step the recurrence of the scheme, stable at m_a = 1.8 m and
+    diverging at m_a = 2.2 m (limit m_a < 2 m)."""
+    def run(name, *sets, want="completed"):
+        out = env.out(name)
+        code, log = env.fsi("sdof_3d.yaml", out, "time.output_every=0", *sets)
+        s = summary(out)
+        assert s["status"] == want, (name, code, s["status"], s["reason"], log[-2000:])
+        assert s["interface"]["solid_nodes"] == 9 and s["interface"]["fluid_nodes"] == 16, s["interface"]
+        p = probes(os.path.join(out, "probes.csv"))
+        assert max(abs(x) for x in p["solid.d_x"] + p["solid.d_y"]) == 0.0, name
+        return p["solid.d_z"], s
+
+    d, _ = run("imvj_appendix", "coupling.acceleration=iqn-imvj", "coupling.iterations.max=20",
+               "coupling.iterations.tolerance=1e-12", "time.end=2")
+    ref = recurrence(0, 100)  # converged, gamma_N1 v cancels: the monolithic recurrence
+    err = max(abs(a - b) for a, b in zip(d, ref))
+    assert len(d) == 100 and err < 1e-12, err
+    print(f"IQN-IMVJ, appendix problem converged: max |d_z - recurrence(gamma 0)| = {err:.1e}")
+
+    am = ("time.end=0.2", "time.dt=0.01", "solid.mass=1", "solid.damping=0.5", "solid.stiffness=4",
+          "fluid.added_mass=10", "fluid.force=[0, 0, 1]", "coupling.gamma_n1=10", "coupling.relaxation=0.5",
+          "coupling.iterations.max=100", "coupling.iterations.tolerance=1e-12")
+    ref = monolithic_added_mass(20)
+    for name, sets in (("imvj_alg1", ("coupling.algorithm=1", "coupling.acceleration=iqn-imvj")),
+                       ("imvj_alg2_svd", ("coupling.acceleration=iqn-imvj",
+                                          "coupling.iqn={imvj: {restart: rs-svd, chunk_size: 3}, filter_type: qr3}")),
+                       ("parallel_ils", ("coupling.scheme=parallel", "coupling.acceleration=iqn-ils")),
+                       ("parallel_imvj", ("coupling.scheme=parallel", "coupling.acceleration=iqn-imvj"))):
+        d, s = run(name, *am, *sets)
+        err = max(abs(a - b) for a, b in zip(d, ref))
+        assert len(d) == 20 and err < 1e-12 * max(map(abs, ref)), (name, err)
+        print(f"{name}: added mass, max |d_z - monolithic| = {err:.1e} (d_z(0.2) = {d[-1]:.4e}), "
+              f"{s['coupling_iterations']} iterations")
+
+    m, dt = 1.0, 0.01
+    for parallel in (False, True):
+        for factor, want in ((0.9, "completed"), (1.1, "diverged")):
+            m_a = factor * 2 * m
+            name = f"robin_auto_{'parallel' if parallel else 'serial'}_{factor}"
+            d, s = run(name, "coupling.algorithm=2", "coupling.gamma_n1=1", "coupling.robin_auto=solid",
+                       "coupling.relaxation=1", "coupling.iterations.max=1", "coupling.iterations.tolerance=0",
+                       "coupling.force_limit=1e6", f"coupling.scheme={'parallel' if parallel else 'serial'}",
+                       "time.dt=0.01", "time.end=6", "solid.mass=1", "solid.damping=0", "solid.stiffness=0",
+                       f"fluid.added_mass={m_a!r}", "fluid.force=[0, 0, 1]", want=want)
+            ref = loosely_coupled_added_mass(parallel, m, m_a, m, dt, 600)
+            # round-off accumulates over 600 steps of a recurrence whose error decays by |z| = 0.9
+            # (serial) or sqrt(0.9) per step: 1e-12 relative measured, 5e-12 asserted
+            err = max(abs(a - b) / (1 + abs(b)) for a, b in zip(d, ref))
+            assert err < 5e-12, (name, err)
+            assert want != "completed" or len(d) == 600, (name, len(d))
+            assert want != "diverged" or "force_limit" in s["reason"], (name, s["reason"])
+            print(f"{name}: {len(d)} steps, {s['status']}, max |d_z - recurrence| / (1 + |d|) = {err:.1e}")
+
+
 def config_errors(env):
     """Bad scenes fail early with the key and the line, and a non-zero exit."""
     code, log = env.fsi("sdof_model.yaml", env.out("typo"), "solid.masss=3")
@@ -310,6 +370,14 @@ def config_errors(env):
     assert code == 1 and "interface mismatch: the solid's interface is 3D (3 values per node), the fluid's 2D" in reason \
         and "solid 'fsi solid_server" in reason and "fluid 'fsi fluid_server" in reason, (code, reason)
     print("mixed dimensions refused:", reason[:160])
+    # The fluid's plate twice as long as the solid's: the two face sets do not end on the same
+    # boundary edges; refused at configure, naming both servers and the edge.
+    out = env.out("larger_fluid")
+    code, log = env.fsi("sdof_3d.yaml", out, "time.output_every=0", "fluid.surface.size=[1, 2]")
+    reason = summary(out)["reason"]
+    assert code == 1 and "interface mismatch: the solid's interface has a boundary edge" in reason \
+        and "solid 'fsi solid_server" in reason and "fluid 'fsi fluid_server" in reason, (code, reason)
+    print("face sets of different extent refused:", reason[:240])
 
 
 def interrupt(env):
@@ -481,5 +549,5 @@ def bad_replies(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (end_to_end, python_solid, python_solid_3d, killed_server, bad_messages, strict_protocol, sessions, added_mass,
+    main({f.__name__: f for f in (end_to_end, python_solid, python_solid_3d, killed_server, bad_messages, strict_protocol, sessions, added_mass, options_3d,
                                   config_errors, interrupt, curve, misbehaving_solid, bad_replies)})

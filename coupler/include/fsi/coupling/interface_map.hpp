@@ -63,7 +63,8 @@ class InterfaceMap {
   MappingKind kind() const { return kind_; }
   // RBF: the support radius used (Wendland C2; 0 for the thin-plate spline), the linear
   // terms kept (2 in the plane; 1 for nodes on a line, 0 for a single node) and the
-  // condition number estimate of the interpolation system (reciprocal of LU's rcond).
+  // condition number estimate of the interpolation system on the null space of the linear
+  // terms (reciprocal of its Cholesky factorisation's rcond).
   double support_radius() const { return support_radius_; }
   int linear_terms() const { return linear_terms_; }
   double condition_estimate() const { return condition_; }
@@ -92,6 +93,17 @@ class InterfaceMap {
   double condition_ = 0;
   int dim_ = 2;  // values per node
 };
+
+// 3D interfaces of faces on both sides (InterfaceMap's constructor calls it): each side's
+// faces form a surface (every edge between corner nodes has one or two faces, and two faces
+// run along their common edge in opposite directions), and the two surfaces end on the same
+// boundary: every boundary edge (an edge of one face) of either side lies within half the
+// element size of a boundary edge of the other (plus its distance to the other's surface:
+// an offset interface is coupling.interface_gap's to judge). Closed surfaces have no boundary edges; an
+// open one (a flag's surface, ending on a wall) must end where the other side's ends. Throws
+// std::invalid_argument naming the side, the edge and the distance otherwise. Point
+// interfaces (no faces) are not checked.
+void check_interface_surfaces(const InterfaceMeshData& solid, const InterfaceMeshData& fluid);
 
 // M_G = int N^T N dgamma on the solid interface (dn x dn, consistent, current
 // configuration = reference + displacement); diag(lumped_measure) for a point interface.
