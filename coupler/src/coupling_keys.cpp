@@ -33,10 +33,17 @@ schema::Key declare_coupling() {
                   "damping M_fs = gamma_N1 int N^T N (Algorithm 2)")
               .req()
               .values({"1", "2"}),
-          choice("scheme", {"serial", "parallel"},
+          choice("scheme", {"serial", "parallel", "robin-neumann"},
                  "serial: the solid, then the fluid with its new interface state (the paper); parallel: both at "
-                 "once (Jacobi), accelerated on the stacked interface state and force")
+                 "once (Jacobi), accelerated on the stacked interface state and force; robin-neumann: explicit, one "
+                 "pass per step: the fluid with a Robin condition of the solid's interface inertia, then the solid "
+                 "with the fluid's traction (Fernandez, Mullaert & Vidrascu 2013, 2015)")
               .def("serial"),
+          integer("robin_neumann_order",
+                  "scheme robin-neumann: the extrapolation of the Robin data, 1 (f* = f_n, v* = 2 v_n - v_(n-1)) or "
+                  "2 (f* = 2 f_n - f_(n-1), v* = 3 v_n - 3 v_(n-1) + v_(n-2))")
+              .def("1")
+              .values({"1", "2"}),
           number("gamma_n1", "Nitsche penalty gamma_N1 (the Robin parameter)").req().ge(0),
           choice("robin_auto", {"none", "solid", "fluid", "both"},
                  "the Robin parameter from the solid's mass per interface measure over dt, (m_s / |Gamma|) / dt, "

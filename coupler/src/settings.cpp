@@ -27,11 +27,11 @@ std::string ConvergenceMeasure::name() const {
 namespace {
 
 void read_relaxation(const schema::Reader& s, CouplingSettings& c) {
-  c.relaxation = s.get<double>("relaxation");
+  c.beta = s.get<double>("relaxation");
   // The stability limit of the relaxed Dirichlet-Neumann iteration on the added-mass model
   // (README): Algorithm 1: 2 m_eff / (m_eff + m_a) < 2; Algorithm 2: 2 (m_eff + gamma mu dt) /
   // (m_eff + m_a), which grows with gamma (and can exceed 2).
-  if (c.algorithm == Algorithm::ExplicitSolidVelocity && !(c.relaxation < 2.0))
+  if (c.algorithm == Algorithm::ExplicitSolidVelocity && !(c.beta < 2.0))
     s.fail("relaxation",
            "(beta) must be in (0, 2) with Algorithm 1 (its stability limit 2 m_eff / (m_eff + m_a) "
            "is below 2)");
@@ -126,8 +126,14 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   const schema::Reader s(section, coupling_section());
   CouplingSettings c;
   c.algorithm = static_cast<Algorithm>(s.get<int>("algorithm"));
-  c.scheme = s.get<std::string>("scheme") == "parallel" ? CouplingScheme::Parallel : CouplingScheme::Serial;
-  c.nitsche_penalty = s.get<double>("gamma_n1");
+  const auto scheme = s.get<std::string>("scheme");
+  c.scheme = scheme == "parallel"        ? CouplingScheme::Parallel
+             : scheme == "robin-neumann" ? CouplingScheme::RobinNeumann
+                                         : CouplingScheme::Serial;
+  if (s.has("robin_neumann_order") && c.scheme != CouplingScheme::RobinNeumann)
+    s.fail("robin_neumann_order", "is only read with 'scheme: robin-neumann' (it is '" + scheme + "')");
+  c.robin_neumann_order = s.get<int>("robin_neumann_order");
+  c.gamma_n1 = s.get<double>("gamma_n1");
   const auto robin_auto = s.get<std::string>("robin_auto");
   c.robin_auto = robin_auto == "solid"   ? RobinAuto::Solid
                  : robin_auto == "fluid" ? RobinAuto::Fluid
@@ -136,15 +142,28 @@ CouplingSettings read_coupling(const ConfigSection& section) {
   if ((c.robin_auto == RobinAuto::Solid || c.robin_auto == RobinAuto::Both) &&
       c.algorithm != Algorithm::ImplicitSolidVelocity)
     s.fail("robin_auto", "on the solid side needs algorithm 2 (Algorithm 1 has no Robin term on the solid)");
-  c.fluid_penalty = s.get_or<double>("fluid_penalty", c.nitsche_penalty);
-  if (c.fluid_penalty == 0 && c.nitsche_penalty > 0)
+  c.gamma_f = s.get_or<double>("fluid_penalty", c.gamma_n1);
+  if (c.gamma_f == 0 && c.gamma_n1 > 0)
     s.fail("fluid_penalty",
            "must be > 0 when gamma_n1 > 0 (the fluid imposes the solid's velocity by Nitsche's "
            "method with this penalty)");
-  c.nitsche_symmetry = s.get<double>("gamma_n2");
+  c.gamma_n2 = s.get<double>("gamma_n2");
   read_relaxation(s, c);
   read_schemes(s, c);
   read_iterations(s.child("iterations"), c);
+  if (c.scheme == CouplingScheme::RobinNeumann) {
+    if (c.max_iterations != 1)
+      s.fail("scheme", "robin-neumann is explicit, one pass per step: give iterations.max 1 (it is " +
+                           std::to_string(c.max_iterations) + ")");
+    if (!c.measures.empty())
+      s.fail("scheme",
+             "robin-neumann is explicit: it has no coupling iterations to converge; give iterations.tolerance 0 and no "
+             "iterations.measures");
+    if (c.algorithm == Algorithm::ImplicitSolidVelocity && c.gamma_n1 > 0)
+      s.fail("scheme",
+             "robin-neumann gives the solid the fluid's traction only: Algorithm 2's damping (gamma_n1 > 0) does not "
+             "apply; use algorithm 1");
+  }
   c.robin_mass = s.get<std::string>("robin_mass") == "solid" ? RobinMass::Solid : RobinMass::Consistent;
   read_mapping(s, c);
   c.force_limit = s.get<double>("force_limit");

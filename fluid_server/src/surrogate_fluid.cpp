@@ -44,6 +44,19 @@ FluidLoads SurrogateFluid::solve_step(const StepInfo& info, const Eigen::VectorX
   return loads(v_, (v_ - v_n_) / info.dt);
 }
 
+FluidLoads SurrogateFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd&, const RobinCondition& robin) {
+  const Eigen::Index d = interface_.dimension();
+  const auto& lumped = interface_.mesh.lumped_measure;
+  for (Eigen::Index j = 0; j < weight_.size(); ++j) {
+    const double a = robin.coefficient[j] * (weight_.size() == 1 ? interface_.measure : lumped[j]);
+    const double m = weight_[j] * added_mass_ / info.dt;
+    v_.segment(d * j, d) = (a * robin.velocity.segment(d * j, d) + robin.traction.segment(d * j, d) +
+                            weight_[j] * force_ + m * v_n_.segment(d * j, d)) /
+                           (m + a);
+  }
+  return loads(v_, (v_ - v_n_) / info.dt);
+}
+
 std::map<std::string, double> SurrogateFluid::accept_step(const StepInfo&) {
   v_n_ = v_;
   const Eigen::VectorXd f = interface_.resultant(last_force_on_solid_);

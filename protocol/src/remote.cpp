@@ -415,6 +415,7 @@ void RemoteFluid::configure(const ConfigSection& section, const FluidSetup& setu
   const auto configured = client_->call(r);
   expect(configured.has_configure(), *client_, "configure");
   interface_ = get_interface(*client_, configured.configure().interface_nodes());
+  supports_robin_ = configured.configure().supports_robin();
 }
 
 namespace {
@@ -452,6 +453,20 @@ FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& 
   s->set_iteration(static_cast<unsigned>(info.iteration));
   from_eigen(d, s->mutable_interface_displacement());
   from_eigen(v, s->mutable_interface_velocity());
+  return loads_from(step_call(*client_, r), interface_, *client_);
+}
+
+FluidLoads RemoteFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd& d, const RobinCondition& robin) {
+  fsi::v1::Request r;
+  auto* s = r.mutable_solve_step();
+  s->set_time(info.time);
+  s->set_dt(info.dt);
+  s->set_step(static_cast<unsigned>(info.step));
+  s->set_iteration(static_cast<unsigned>(info.iteration));
+  from_eigen(d, s->mutable_interface_displacement());
+  from_eigen(robin.coefficient, s->mutable_robin()->mutable_coefficient());
+  from_eigen(robin.velocity, s->mutable_robin()->mutable_velocity());
+  from_eigen(robin.traction, s->mutable_robin()->mutable_traction());
   return loads_from(step_call(*client_, r), interface_, *client_);
 }
 

@@ -384,6 +384,7 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       interface_nodes_ = model_->interface().nodes();
       dimension_ = model_->interface().dimension;
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
+      reply.mutable_configure()->set_supports_robin(model_->supports_robin());
       break;
     }
     case R::kInitialLoads: {
@@ -398,6 +399,19 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       need_model("solve_step");
       const auto& s = request.solve_step();
       const StepInfo info = checked_step(s);
+      if (s.has_robin()) {
+        if (!model_->supports_robin())
+          throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                            fmt::format("fluid model '{}' does not take a Robin interface condition (SolveStep.robin)",
+                                        model_->name()));
+        const auto& rc = s.robin();
+        loads_reply(model_->solve_robin(
+            info, checked_vector(s.interface_displacement(), interface_nodes_, dimension_, "interface_displacement"),
+            RobinCondition{checked_vector(rc.coefficient(), interface_nodes_, 1, "robin.coefficient"),
+                           checked_vector(rc.velocity(), interface_nodes_, dimension_, "robin.velocity"),
+                           checked_vector(rc.traction(), interface_nodes_, dimension_, "robin.traction")}));
+        break;
+      }
       loads_reply(model_->solve_step(
           info, checked_vector(s.interface_displacement(), interface_nodes_, dimension_, "interface_displacement"),
           checked_vector(s.interface_velocity(), interface_nodes_, dimension_, "interface_velocity")));

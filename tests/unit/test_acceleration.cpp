@@ -56,7 +56,7 @@ CouplingSettings quasi_newton(const std::string& scheme, QrFilter filter = QrFil
                               Preconditioner pre = Preconditioner::None) {
   CouplingSettings s;
   s.acceleration = scheme;
-  s.relaxation = 0.5;
+  s.beta = 0.5;
   s.reuse_steps = 0;
   s.iqn_filter_type = filter;
   // qr1 tests |R_ii| against ||R||_F, which the first (largest) columns dominate: its limit
@@ -87,7 +87,7 @@ TEST_P(LinearProblem, ConvergesInAtMostNPlusOneUpdates) {
     EXPECT_LE(updates, n + 1) << "seed " << seed;
     // ... where the plain iteration with the same first relaxation needs far more.
     CouplingSettings plain;
-    plain.relaxation = 1.0;
+    plain.beta = 1.0;
     auto constant = fsi::coupling::make_accelerator(plain);
     EXPECT_GT(updates_to_converge(*constant, a, b, x, 200), 2 * n) << "seed " << seed;
   }

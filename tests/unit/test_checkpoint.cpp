@@ -181,7 +181,7 @@ TEST(OutputDir, FreshRefusesForceCleansResumeKeeps) {
 TEST(Accelerator, SavedIqnHistoryGivesIdenticalUpdates) {
   fsi::coupling::CouplingSettings s;
   s.acceleration = "iqn-ils";
-  s.relaxation = 0.3;
+  s.beta = 0.3;
   s.reuse_steps = 3;
   // A linear interface problem F = G(F) = A F + b that changes slowly with the step.
   auto residual = [](const Eigen::VectorXd& x, int step) {

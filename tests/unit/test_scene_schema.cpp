@@ -187,7 +187,7 @@ TEST(DeclaredOnce, CouplingSettingsInitialisersAreTheDeclaredDefaults) {
       "s.yaml");
   const auto read = fsi::coupling::read_coupling(scene.section("coupling"));
   const fsi::coupling::CouplingSettings init;
-  EXPECT_EQ(read.nitsche_symmetry, init.nitsche_symmetry);
+  EXPECT_EQ(read.gamma_n2, init.gamma_n2);
   EXPECT_EQ(read.predictor, init.predictor);
   EXPECT_EQ(read.acceleration, init.acceleration);
   EXPECT_EQ(read.iqn_filter, init.iqn_filter);

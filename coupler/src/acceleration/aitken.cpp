@@ -19,7 +19,7 @@ class Aitken : public Accelerator {
   Eigen::VectorXd update(const Eigen::VectorXd& x, const Eigen::VectorXd& r) override {
     ++k_;
     last_columns_ = 0;
-    const double beta = settings_.relaxation;
+    const double beta = settings_.beta;
     double omega = beta;
     if (k_ > 1 && previous_r_.size() == r.size()) {
       const Eigen::VectorXd dr = r - previous_r_;

@@ -10,7 +10,7 @@ class ConstantRelaxation : public Accelerator {
   Eigen::VectorXd update(const Eigen::VectorXd& x, const Eigen::VectorXd& r) override {
     ++k_;
     last_columns_ = 0;
-    last_omega_ = settings_.relaxation;
+    last_omega_ = settings_.beta;
     return x + last_omega_ * r;
   }
 };

@@ -21,8 +21,8 @@ class IqnIls : public QuasiNewton {
     const Eigen::Index m = c.m;
     last_columns_ = static_cast<int>(m);
     if (m == 0) {
-      last_omega_ = settings_.relaxation;
-      return x + settings_.relaxation * r;
+      last_omega_ = settings_.beta;
+      return x + settings_.beta * r;
     }
     // min |P (V c + r)| = min |Q R c + P r|  =>  R c = -Q^T P r
     const Eigen::VectorXd coeff = solve(c, -r);

@@ -74,8 +74,8 @@ Eigen::VectorXd IqnImvj::quasi_newton_update(const Eigen::VectorXd& x, const Eig
   last_columns_ = static_cast<int>(m);
   last_valid_ = false;
   if (m == 0 && !has_prior()) {
-    last_omega_ = settings_.relaxation;
-    return x + settings_.relaxation * r;
+    last_omega_ = settings_.beta;
+    return x + settings_.beta * r;
   }
   last_omega_ = 0;
   Eigen::VectorXd next = xt;

@@ -499,12 +499,12 @@ SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd
     v_ = (d_ - d_n_) / dt;
     a_ = (v_ - v_n_) / dt;
   } else {
-    const double beta = 0.25, gamma = 0.5;
+    const double newmark_beta = 0.25, newmark_gamma = 0.5;
     TimeTerms t;
-    t.mass_coefficient = 1.0 / (beta * dt * dt);
-    t.acceleration_history = -(d_n_ + dt * v_n_) / (beta * dt * dt) - (0.5 / beta - 1.0) * a_n_;
-    t.damping_coefficient = gamma * dt * t.mass_coefficient;
-    t.velocity_history = v_n_ + dt * (1 - gamma) * a_n_ + gamma * dt * t.acceleration_history;
+    t.mass_coefficient = 1.0 / (newmark_beta * dt * dt);
+    t.acceleration_history = -(d_n_ + dt * v_n_) / (newmark_beta * dt * dt) - (0.5 / newmark_beta - 1.0) * a_n_;
+    t.damping_coefficient = newmark_gamma * dt * t.mass_coefficient;
+    t.velocity_history = v_n_ + dt * (1 - newmark_gamma) * a_n_ + newmark_gamma * dt * t.acceleration_history;
     d_ = d_n_ + dt * v_n_;
     newton(d_, f_, t, info);
     a_ = t.mass_coefficient * d_ + t.acceleration_history;

@@ -184,6 +184,18 @@ struct FluidLoads {
   NodalMatrix interface_mass;  // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
 };
 
+// The explicit Robin-Neumann scheme's interface condition on the fluid (coupling.scheme:
+// robin-neumann), in place of the velocity Nitsche's method imposes: at every interface node j
+//   f_sigma_j + A_j v_f,j = A_j v*_j + f*_j,   A_j = coefficient_j x (node j's lumped measure),
+// f_sigma the fluid's interface traction force (FluidLoads::traction_force) and v_f its
+// interface velocity, both unknown. The coefficient is the solid's interface inertia (its mass
+// per interface measure over dt); v* and f* are extrapolated from the accepted steps.
+struct RobinCondition {
+  Eigen::VectorXd coefficient;  // per interface node, per unit measure (kg / (m^2 s) in 3D)
+  Eigen::VectorXd velocity;     // v* (dimension x nodes, interleaved)
+  Eigen::VectorXd traction;     // f* (nodal forces, as traction_force)
+};
+
 class FluidModel : public IterationReporting {
  public:
   virtual ~FluidModel() = default;
@@ -197,6 +209,12 @@ class FluidModel : public IterationReporting {
   // Nitsche's method, solves step n+1 and returns the interface loads.
   virtual FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                 const Eigen::VectorXd& interface_velocity) = 0;
+  // The same step with the Robin condition on the interface instead (supports_robin()).
+  virtual bool supports_robin() const { return false; }
+  virtual FluidLoads solve_robin(const StepInfo& /*info*/, const Eigen::VectorXd& /*interface_displacement*/,
+                                 const RobinCondition& /*robin*/) {
+    throw std::logic_error("fluid '" + name() + "' does not take a Robin interface condition");
+  }
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
   // Statistics of the run so far (summary.json's "fluid_diagnostics"); see SolidModel. Optional.
   virtual std::map<std::string, double> diagnostics() const { return {}; }

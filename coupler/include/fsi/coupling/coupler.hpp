@@ -19,6 +19,20 @@
 // pairs, the work accumulators, counters) under OUT/checkpoints/ (checkpoint.hpp); a
 // resumed run continues from the newest one and writes the same probes.csv, byte for byte.
 //
+// Glossary (name -> the paper's symbol -> unit; proto/README.md has the protocol's side):
+//   settings_.gamma_n1  gamma_N1  Robin parameter, Algorithm 2's damping   kg/(m^2 s)
+//   settings_.gamma_f   gamma_f   the fluid's Nitsche penalty (= gamma_N1)  kg/(m^2 s)
+//   settings_.gamma_n2  gamma_N2  Nitsche symmetry switch                   -
+//   settings_.beta      beta      relaxation                                -
+//   Step::force         F^(k)     nodal force on the solid                  N
+//   robin_force()       F*        the algorithm's force from the fluid       N
+//   FluidLoads          f_sigma, f_v = int N^T sigma n, int N^T v_f          N, m^3/s
+//   mapped_mass         M_G = H^T M_f H, int N^T N on the interface          m^2
+//
+// The parts: coupler.cpp (the step: run()'s loop, F*, measures, accept), run_setup.cpp
+// (configuring, the set-up's report), run_lifecycle.cpp (start state, resume, fork, tables,
+// checkpoints) and src/schemes/ (serial, parallel, robin-neumann behind Coupler::Scheme).
+//
 // Usage: Coupler c(solid, fluid, scene, out_dir); RunOutcome r = c.run();
 // The models may be in-process (tests) or remote proxies (protocol/remote.hpp).
 #include <Eigen/Core>
@@ -26,6 +40,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "fsi/common/config.hpp"
@@ -102,6 +117,11 @@ class Coupler {
   struct Iterate;  // one coupling iteration's solves; a step accepts its last one
   struct Step;     // the step being iterated: F^(k), the residuals, the measures
   struct Update;   // what one coupling iteration gives: F^(k+1) and the residual quantities
+  struct Scheme;   // coupling.scheme: the iteration's solves, behind one interface (src/schemes/)
+  struct SerialScheme;
+  struct ParallelScheme;
+  struct RobinNeumannScheme;
+  std::unique_ptr<Scheme> make_scheme();
   // 1. The scene's time and coupling sections; both solvers configured, the interface map.
   TimeSettings configure(InterfaceMeshData& fluid_interface);
   void automatic_robin(const TimeSettings& time);  // coupling.robin_auto: gamma from the solid's mass
@@ -121,12 +141,11 @@ class Coupler {
   // 3. One step: its iterations, then accept.
   Step begin_step(Run& r, int n);
   Update begin_iteration(Run& r, const Step& step);  // signal check, Algorithm 2's damping to the solid
-  Update coupling_iteration(Run& r, Step& step);     // solid, fluid, F*, residual, F^(k+1)
-  Update parallel_iteration(Run& r, Step& step);     // solid and fluid at once, x^(k+1)
-  void stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force);
+  Eigen::VectorXd traction_mismatch(Iterate& it, const Eigen::VectorXd& fs, const Eigen::VectorXd& fv,
+                                    const Eigen::VectorXd& d, const Eigen::VectorXd& v,
+                                    const Eigen::VectorXd& force) const;              // H^T R into it, and its mismatch
   void measure(Step& step, Update& u, const Eigen::VectorXd& traction_change) const;  // residual quantities
-  double parallel_gap_limit() const;                     // the interface state's convergence limit
-  bool measures_met(Step& step, const Update& u) const;  // the convergence measures
+  bool measures_met(Step& step, const Update& u) const;                               // the convergence measures
   // The iteration's row in iterations.csv, F^(k+1); throws on divergence; true when converged.
   bool finish_iteration(Run& r, Step& step, const Update& u, bool met);
   void check_unconverged(const Step& step) const;  // strict measures, stop_if_not_converged

@@ -63,7 +63,12 @@ enum class ImvjRestart { None, Zero, LeastSquares, Svd };
 //             block scaled by its size (preCICE's parallel implicit coupling). With one
 //             iteration per step it is a parallel explicit scheme: the fluid gets the
 //             predicted d_n + dt v_n, v_n.
-enum class CouplingScheme { Serial, Parallel };
+//   robin-neumann  explicit (one pass per step, no iterations): the fluid with the Robin
+//             condition f_sigma + A v_f = A v* + f* (A the solid's interface mass over dt, v*
+//             and f* extrapolated from the accepted steps), then the solid with the fluid's
+//             traction (the generalised Robin-Neumann scheme of Fernandez, Mullaert and
+//             Vidrascu 2015). robin_neumann_order 1 or 2 is the extrapolation's order.
+enum class CouplingScheme { Serial, Parallel, RobinNeumann };
 // The automatic Robin parameter (coupling.robin_auto): gamma_auto = (m_s / |Gamma|) / dt, the
 // solid's mass per interface measure (as the solid reports it) over the time step, replaces
 // gamma_N1 (the solid side: Algorithm 2's damping and its lagged Robin term), the fluid's
@@ -74,13 +79,14 @@ struct CouplingSettings {
   Algorithm algorithm = Algorithm::ExplicitSolidVelocity;
   CouplingScheme scheme = CouplingScheme::Serial;
   RobinAuto robin_auto = RobinAuto::None;
-  double nitsche_penalty = 0;  // gamma_N1 >= 0
+  int robin_neumann_order = 1;
+  double gamma_n1 = 0;  // gamma_N1 >= 0
   // The fluid's Nitsche penalty gamma_f (its weak no-slip v_f = v_s on the interface). The
   // paper uses one parameter: gamma_f = gamma_N1 (the default). Set apart, the converged
   // coupled solution no longer depends on the Robin parameter gamma_N1 of Algorithm 2.
-  double fluid_penalty = 0;
-  double nitsche_symmetry = -1;  // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
-  double relaxation = 1;         // beta in (0, 1]
+  double gamma_f = 0;
+  double gamma_n2 = -1;  // gamma_N2 = +1 symmetric, -1 unsymmetric (the paper)
+  double beta = 1;       // beta in (0, 1]
   // F^(1)_{n+1} from the accepted forces: a name of predictor.hpp's registry ("previous" =
   // F_n, the paper).
   std::string predictor = "previous";

@@ -30,6 +30,11 @@ class SurrogateFluid : public FluidModel {
   InterfaceMeshData interface() const override;
   FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
+  // The Robin condition in closed form, node by node: with the force on the solid
+  // w_j (F - m_a (v_j - v_n,j) / dt) = -f_sigma_j, v_j (w_j m_a / dt + A_j) = A_j v*_j + f*_j +
+  // w_j F + w_j m_a v_n,j / dt.
+  bool supports_robin() const override { return true; }
+  FluidLoads solve_robin(const StepInfo& info, const Eigen::VectorXd& d, const RobinCondition& robin) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   // Checkpoints: "surrogate.v_n" (accepted interface velocity), "surrogate.v" (of the last
   // solve), "surrogate.force_on_solid" (of the last solve), dimension x nodes values each.

@@ -58,6 +58,8 @@ class RemoteFluid : public FluidModel {
   InterfaceMeshData interface() const override { return interface_; }
   FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
+  bool supports_robin() const override { return supports_robin_; }
+  FluidLoads solve_robin(const StepInfo& info, const Eigen::VectorXd& d, const RobinCondition& robin) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
@@ -77,6 +79,7 @@ class RemoteFluid : public FluidModel {
   std::string server_name_ = "fluid server";
   bool supports_checkpoint_ = false;
   bool supports_output_ = false;
+  bool supports_robin_ = false;
   InterfaceMeshData interface_;
 };
 
