@@ -227,8 +227,8 @@ void Coupler::describe_setup(nlohmann::json& data, const TimeSettings& time, con
                                          {"truncation", settings_.imvj_truncation}};
   }
   log->info("algorithm {}, gamma_N1 = {}, beta = {}, k_max = {}, tolerance = {}; {} solid / {} fluid interface nodes",
-            to_string(settings_.algorithm), gamma, settings_.beta, settings_.max_iterations, settings_.tolerance,
-            ns, fluid_interface.nodes());
+            to_string(settings_.algorithm), gamma, settings_.beta, settings_.max_iterations, settings_.tolerance, ns,
+            fluid_interface.nodes());
   if (settings_.gamma_f != gamma)
     log->info("the fluid's Nitsche penalty gamma_f = {} is set apart from gamma_N1{}", settings_.gamma_f,
               implicit ? "" : " (Algorithm 1 uses gamma_f only: gamma_N1 has no effect)");
