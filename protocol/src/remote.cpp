@@ -235,6 +235,16 @@ std::string hello(ProtocolClient& client, fsi::v1::ServerKind expected, bool* su
   return reply.hello().server_name();
 }
 
+// A SolveStep request's step fields (time, dt, step, iteration); the caller adds the data.
+fsi::v1::SolveStep* step_request(fsi::v1::Request& r, const StepInfo& info) {
+  auto* s = r.mutable_solve_step();
+  s->set_time(info.time);
+  s->set_dt(info.dt);
+  s->set_step(static_cast<unsigned>(info.step));
+  s->set_iteration(static_cast<unsigned>(info.iteration));
+  return s;
+}
+
 // A solver failure on the server side is a SolverError on this side (the run diverged),
 // any other error reply stays a RemoteError (the run failed).
 fsi::v1::Reply step_call(ProtocolClient& client, const fsi::v1::Request& r) {
@@ -372,11 +382,7 @@ void RemoteSolid::configure(const ConfigSection& section, const SolidSetup& setu
 
 SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& force) {
   fsi::v1::Request r;
-  auto* s = r.mutable_solve_step();
-  s->set_time(info.time);
-  s->set_dt(info.dt);
-  s->set_step(static_cast<unsigned>(info.step));
-  s->set_iteration(static_cast<unsigned>(info.iteration));
+  auto* s = step_request(r, info);
   from_eigen(force, s->mutable_interface_force());
   if (send_interface_mass_) nodal_to_proto(interface_mass_, s->mutable_interface_mass());
   const auto reply = step_call(*client_, r);
@@ -446,11 +452,7 @@ FluidLoads RemoteFluid::initial_loads(const Eigen::VectorXd& d, const Eigen::Vec
 
 FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) {
   fsi::v1::Request r;
-  auto* s = r.mutable_solve_step();
-  s->set_time(info.time);
-  s->set_dt(info.dt);
-  s->set_step(static_cast<unsigned>(info.step));
-  s->set_iteration(static_cast<unsigned>(info.iteration));
+  auto* s = step_request(r, info);
   from_eigen(d, s->mutable_interface_displacement());
   from_eigen(v, s->mutable_interface_velocity());
   return loads_from(step_call(*client_, r), interface_, *client_);
@@ -458,11 +460,7 @@ FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& 
 
 FluidLoads RemoteFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd& d, const RobinCondition& robin) {
   fsi::v1::Request r;
-  auto* s = r.mutable_solve_step();
-  s->set_time(info.time);
-  s->set_dt(info.dt);
-  s->set_step(static_cast<unsigned>(info.step));
-  s->set_iteration(static_cast<unsigned>(info.iteration));
+  auto* s = step_request(r, info);
   from_eigen(d, s->mutable_interface_displacement());
   from_eigen(robin.coefficient, s->mutable_robin()->mutable_coefficient());
   from_eigen(robin.velocity, s->mutable_robin()->mutable_velocity());
