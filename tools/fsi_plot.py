@@ -36,6 +36,20 @@ def diagnostic(name):
             or ".mesh_" in name)
 
 
+def constant_to(y, limit=1e-6):
+    """The relative spread (max - min) / |median| of a probe whose values are constant to
+    within limit (a steady probe); None for a probe that changes, or one that is zero."""
+    import numpy as np
+    y = y[np.isfinite(y)]
+    if y.size < 2:
+        return None
+    scale = abs(float(np.median(y)))
+    if scale == 0:
+        return None
+    spread = float(y.max() - y.min()) / scale
+    return max(spread, 1e-16) if spread <= limit else None
+
+
 def th_stats_script():
     for p in (HERE / "th_stats.py", HERE.parent / "bench" / "fsi" / "th_stats.py"):
         if p.is_file():
@@ -49,6 +63,7 @@ def plot_run(folder, quiet):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from fsi.plots import wrap_title
+    from fsi.units import label as unit_label
 
     import csv
     with open(folder / "probes.csv", newline="") as fh:
@@ -80,7 +95,12 @@ def plot_run(folder, quiet):
     for ax, c in zip(axes[:, 0], shown):
         y = data[:, header.index(c)]
         ax.plot(t, y, lw=0.9)
-        ax.set_ylabel(c, fontsize=8)
+        ax.ticklabel_format(axis="y", useOffset=False)
+        flat = constant_to(y)
+        if flat is not None:  # a steady probe: a flat line with its value, not round-off magnified
+            mid, scale = float(np.nanmedian(y)), max(abs(float(np.nanmedian(y))), 1e-300)
+            ax.set_ylim(mid - 0.05 * scale, mid + 0.05 * scale)
+        ax.set_ylabel(unit_label(c, summary.get("parameters")), fontsize=8)
         ax.grid(alpha=0.3)
         s = stats.get(c) or {}
         note = ""
@@ -97,6 +117,8 @@ def plot_run(folder, quiet):
             note = f"final {s['final']:.6g}, still changing"
             if s.get("periods"):
                 note += f" ({s['periods']} whole period{'s' if s['periods'] > 1 else ''}: fewer than 3)"
+        if flat is not None:
+            note = (note + "; " if note else "") + f"constant to {flat:.0e} (relative)"
         if note:
             ax.text(0.01, 0.95, note, transform=ax.transAxes, va="top", fontsize=8,
                     bbox={"facecolor": "white", "alpha": 0.7, "lw": 0})

@@ -81,6 +81,10 @@ std::vector<Key> scene_keys() {
   std::vector<Key> keys = {
       text("scene", "the scene's name"),
       text("description", "one line about the scene"),
+      choice("units", {"SI", "CGS"},
+             "the unit system of the scene's numbers, for the units in plot labels and tables only: the solvers "
+             "take no unit system of their own (SI: m, kg, s, N, Pa; CGS: cm, g, s, dyn, dyn/cm^2)")
+          .def("SI"),
       time_section(),
   };
   auto& r = registry();

@@ -1,5 +1,7 @@
 // Configuring a run: the scene's time and coupling sections, both solvers, the interface map,
 // and the set-up's report (summary.json's "interface" and "coupling", log lines, warnings).
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -24,13 +26,16 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   settings_ = read_coupling(scene_.section("coupling"));
   scene_.check_all_used("coupling");
   scene_.check_all_used("time");
+  // The top-level keys are the schema's (scene, description, units, time, the declared sections),
+  // and the peers' sections, which the peers check.
+  std::vector<std::string> known;
+  for (const auto& k : schema::scene_keys()) known.push_back(k.name);
+  for (const char* peer : {"solid", "fluid"})
+    if (std::find(known.begin(), known.end(), peer) == known.end()) known.emplace_back(peer);
   for (const auto& key : scene_.root().keys())
-    if (key != "scene" && key != "description" && key != "time" && key != "coupling" && key != "solid" &&
-        key != "fluid")
-      throw ConfigError(
-          fmt::format("{}: unknown top-level section '{}' (known: scene, description, time, "
-                      "coupling, solid, fluid)",
-                      scene_.root().where(key), key));
+    if (std::find(known.begin(), known.end(), key) == known.end())
+      throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: {})", scene_.root().where(key), key,
+                                    fmt::join(known, ", ")));
   if (settings_.predictor != "previous")
     log->warn(
         "predictor '{}' ({}) can excite interface modes the iterations leave unconverged (docs/fsi.md); "

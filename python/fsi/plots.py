@@ -133,15 +133,19 @@ def histories(ax, runs, probe, labels=None):
     from fsi.results import load, Results
     if isinstance(runs, dict):
         labels, runs = list(runs), list(runs.values())
+    from fsi.units import label as unit_label
     lines = []
+    parameters = None
     for i, r in enumerate(runs):
         if hasattr(r, "out") and not isinstance(r, Results):  # an fsi.run() result: its folder
             r = r.out
         res = r if isinstance(r, Results) else load(r)
         label = labels[i] if labels else str(res.out)
         lines += ax.plot(res["time"], res[probe], label=label)
+        if parameters is None:
+            parameters = res.summary.get("parameters") or {}
     ax.set_xlabel("time [s]")
-    ax.set_ylabel(probe)
+    ax.set_ylabel(unit_label(probe, parameters))
     ax.grid(alpha=0.3)
     sort_legend(ax)
     return lines

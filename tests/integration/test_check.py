@@ -145,6 +145,8 @@ def out_of_range():
     expect(["check", "configs/sdof_model.yaml", "--set", "time.end=10.01"], 1, "",
            "configs/sdof_model.yaml:12:3: 'time.end' (10.01) must be a whole number of time steps dt = 0.02: "
            "end / dt = 500.5; use 10 (500 steps) or 10.02 (501 steps)\n")
+    expect(["check", "configs/sdof_model.yaml", "--set", "units=furlongs"], 1, "",
+           "configs/sdof_model.yaml (--set units=furlongs): 'units' must be one of SI, CGS, got 'furlongs'\n")
     expect(["check", "configs/fsi3.yaml", "--set", "fluid.umfpack_irstep=3", "--set", "time.checkpoint_keep=0"], 1,
            "", "configs/fsi3.yaml (--set time.checkpoint_keep=0): 'time.checkpoint_keep' must be >= 1, got '0'\n"
            "configs/fsi3.yaml (--set fluid.umfpack_irstep=3): 'fluid.umfpack_irstep' must be in [0, 2], got '3'\n")

@@ -1,5 +1,6 @@
 """PNGs from a study folder: work precision, stability map, outcomes, histories."""
 import csv
+import json
 import math
 from pathlib import Path
 
@@ -9,7 +10,17 @@ import yaml
 from .analysis import read_probes
 from .forms import SCALAR_FORMS, evaluate
 from .util import ABBREV, read_json
+from ..units import label as unit_label
 
+
+def run_parameters(runs_dir, runs):
+    """The scene parameters (summary.json) of the first of these runs that has them, for units."""
+    for r in runs:
+        try:
+            return json.loads((Path(runs_dir) / r["name"] / "summary.json").read_text()).get("parameters") or {}
+        except (OSError, ValueError):
+            continue
+    return {}
 
 def load_results(d):
     with open(Path(d) / "results.csv") as f:
@@ -203,8 +214,8 @@ def plot_histories(plt, d, rows, meta, cfg):
             label = "reference" if is_ref else ", ".join(f"{ABBREV.get(k, k)}={r.get(k)}" for k in varied)
             ax.plot(data["time"], data[p], "k-" if is_ref else "-", lw=2.2 if is_ref else 1.0, label=label,
                     zorder=3 if is_ref else 2)
-        ax.set_xlabel("time")
-        ax.set_ylabel(p)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(unit_label(p, run_parameters(Path(d) / "runs", ref + others)))
         ax.set_title(cfg.get("title", f"{meta.get('study', '')}: {p}"))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
