@@ -309,8 +309,9 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
       set_interface_mass(nodal_interface_mass(interface_, Eigen::VectorXd()));
   }
 
-  // 8. Rigid obstacles (contact).
+  // 8. Rigid obstacles (contact) and elastic supports.
   configure_obstacles(s, constants);
+  configure_supports(s);
 
   // 9. Probes: displacement of named points, interpolated in the cell that holds them.
   probes_.clear();
@@ -378,14 +379,9 @@ void FemSolid::configure_obstacles(const schema::Reader& s, const ElasticConstan
     } catch (const std::invalid_argument& e) {
       o.fail("boundary", e.what());
     }
-    std::vector<Facet> unique;
-    std::set<std::vector<int>> own;
+    const std::vector<Facet> unique = unique_facets(mine);
     double h = 1e300;
-    for (const auto& f : mine) {
-      std::vector<int> key = f;
-      std::sort(key.begin(), key.end());
-      if (!own.insert(key).second) continue;
-      unique.push_back(f);
+    for (const auto& f : unique) {
       for (std::size_t a = 0; a < f.size(); ++a)
         h = std::min(h, (mesh_.nodes.row(f[a]) - mesh_.nodes.row(f[(a + 1) % f.size()])).norm());
     }
@@ -411,6 +407,30 @@ void FemSolid::configure_obstacles(const schema::Reader& s, const ElasticConstan
         i, obstacles[i].contact_gap, obstacles[i].stiffness, contact->candidates(static_cast<int>(i)),
         contact->excluded(static_cast<int>(i)));
   system_->set_contact(std::move(contact));
+}
+
+void FemSolid::configure_supports(const schema::Reader& s) {
+  std::vector<SupportSpec> specs;
+  const auto list = s.list("elastic_supports");
+  for (const auto& e : list) {
+    SupportSpec spec;
+    try {
+      spec.facets = unique_facets(mesh_.facets(e.names("boundary")));
+    } catch (const std::invalid_argument& err) {
+      e.fail("boundary", err.what());
+    }
+    if (spec.facets.empty()) e.fail("boundary", "names no facets");
+    spec.stiffness = e.get<double>("stiffness");
+    spec.normal_only = e.get<std::string>("direction") == "normal";
+    specs.push_back(std::move(spec));
+  }
+  if (specs.empty()) {
+    system_->set_support(nullptr);
+    return;
+  }
+  auto support = std::make_shared<ElasticSupport>(mesh_, specs);
+  fsi::logger("solid")->info("elastic supports: {} boundary nodes", support->nodes());
+  system_->set_support(std::move(support));
 }
 
 void FemSolid::set_interface_mass(const NodalMatrix& m) {

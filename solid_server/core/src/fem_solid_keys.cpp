@@ -113,6 +113,20 @@ const std::vector<schema::Key>& fem_solid_keys() {
               names("boundary", "facet set(s) that may touch it").def_computed("every facet set of the mesh"),
           })
           .def("[]"),
+      section_list(
+          "elastic_supports",
+          "elastic supports (a foundation) on boundary facets: the traction -k_s (u . n) n (or -k_s u), n the "
+          "outward normal; the tissue around a vessel, or the hoop stiffness a plane-strain tube wall lacks",
+          {
+              names("boundary", "facet set(s) supported").req(),
+              number("stiffness", "k_s: traction per displacement (a 2D stand-in for a tube's wall: E h / (2 R^2))")
+                  .req()
+                  .gt(0)
+                  .in_unit("Pa/m"),
+              choice("direction", {"normal", "all"}, "normal: along the outward normal only; all: every component")
+                  .def("normal"),
+          })
+          .def("[]"),
       section_list("probes", "displacement of points (probes NAME_x, NAME_y, and NAME_z in 3D)",
                    {
                        text("name", "probe name").req(),

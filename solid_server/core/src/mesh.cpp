@@ -15,6 +15,17 @@ std::vector<std::string> SolidMesh::facet_set_names() const {
   return names;
 }
 
+std::vector<Facet> unique_facets(const std::vector<Facet>& facets) {
+  std::vector<Facet> unique;
+  std::set<std::vector<int>> seen;
+  for (const auto& f : facets) {
+    std::vector<int> key = f;
+    std::sort(key.begin(), key.end());
+    if (seen.insert(key).second) unique.push_back(f);
+  }
+  return unique;
+}
+
 std::vector<Facet> SolidMesh::facets(const std::vector<std::string>& names) const {
   std::vector<Facet> out;
   for (const auto& name : names) {

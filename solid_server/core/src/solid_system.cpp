@@ -298,6 +298,7 @@ Eigen::VectorXd SolidSystem::residual(const Eigen::VectorXd& d, const Eigen::Vec
   if (damping_.nonZeros() && (t.damping_coefficient != 0 || t.velocity_history.size()))
     r += damping_ * time_vector(t.damping_coefficient, d, t.velocity_history);
   if (contact_) contact_->add_to_residual(d, r);
+  if (support_) support_->add_to_residual(d, r);
   return r;
 }
 
@@ -336,6 +337,12 @@ void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ex
   if (contact_) {
     contact_->add_to_residual(d, r);
     contact_->add_to_tangent(d, [&](int row, int col, double value) {
+      if (equation_[row] >= 0 && equation_[col] >= 0) values[full_to_reduced_[position(row, col)]] += value;
+    });
+  }
+  if (support_) {
+    support_->add_to_residual(d, r);
+    support_->add_to_tangent([&](int row, int col, double value) {
       if (equation_[row] >= 0 && equation_[col] >= 0) values[full_to_reduced_[position(row, col)]] += value;
     });
   }

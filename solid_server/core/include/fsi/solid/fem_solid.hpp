@@ -98,6 +98,7 @@ class FemSolid : public fsi::SolidModel {
   Eigen::VectorXd external_force(const Eigen::VectorXd& interface_force) const;
   void newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTerms& t, const StepInfo& info);
   void configure_obstacles(const schema::Reader& s, const ElasticConstants& constants);
+  void configure_supports(const schema::Reader& s);
 
   SolidMesh mesh_;
   std::unique_ptr<SolidSystem> system_;

@@ -32,6 +32,10 @@ struct SolidMesh {
   std::vector<std::string> facet_set_names() const;
 };
 
+// The facets without repeats (a facet in two named sets, or listed twice, counted once), in
+// order of first appearance.
+std::vector<Facet> unique_facets(const std::vector<Facet>& facets);
+
 // Structured nx x ny Q4 mesh of [x0, x0+lx] x [y0, y0+ly]; edge sets "left", "right",
 // "bottom", "top". Node (i, j) has id j * (nx + 1) + i.
 SolidMesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int ny);

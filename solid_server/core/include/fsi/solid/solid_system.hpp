@@ -2,7 +2,7 @@
 // The discrete solid: assembly of internal force and tangent on a fixed sparsity pattern,
 // constant operators (mass, interface mass, body force), Dirichlet dofs by elimination,
 // and a Newton solver for
-//     R(d) = M (c_a d + a_hist) + C (c_v d + v_hist) + F_int(d) - F_ext - F_contact(d) = 0
+//     R(d) = M (c_a d + a_hist) + C (c_v d + v_hist) + F_int(d) - F_ext - F_contact(d) + K_s d = 0
 // on the free dofs (c_a = c_v = 0 for statics). The time scheme lives in the caller.
 //
 // Usage:
@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "fsi/solid/contact.hpp"
+#include "fsi/solid/elastic_support.hpp"
 #include "fsi/solid/element.hpp"
 #include "fsi/solid/material.hpp"
 #include "fsi/solid/mesh.hpp"
@@ -112,6 +113,10 @@ class SolidSystem {
   // the Newton matrix; nothing changes while every gap stays at or above its g_c.
   void set_contact(std::shared_ptr<const ObstacleContact> contact) { contact_ = std::move(contact); }
   const ObstacleContact* contact() const { return contact_.get(); }
+  // Elastic supports (elastic_support.hpp): their linear force K_s d enters the residual and
+  // K_s the tangent (null: none).
+  void set_support(std::shared_ptr<const ElasticSupport> support) { support_ = std::move(support); }
+  const ElasticSupport* support() const { return support_.get(); }
 
   Eigen::VectorXd body_force(const Eigen::VectorXd& force_per_volume) const;  // dim components
   Eigen::VectorXd body_force(const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& f, int gauss = 3) const;
@@ -171,6 +176,7 @@ class SolidSystem {
   std::vector<int> cell_positions_;   // (dofs per cell)^2 per cell: full value index
   SparseDirectSolver solver_;
   std::shared_ptr<const ObstacleContact> contact_;  // null: no obstacles
+  std::shared_ptr<const ElasticSupport> support_;   // null: no elastic supports
   ElementKind element_ = ElementKind::Q4;
   template <class Shape>
   ElementStateT<Shape> cell_state(int cell, const Eigen::VectorXd& d, bool with_tangent) const;
