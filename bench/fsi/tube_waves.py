@@ -5,7 +5,8 @@ speed from a run's probes.csv, and the differences between runs.
   /usr/bin/python3 bench/fsi/tube_waves.py RUN [RUN ...] [--reference RUN] [--json OUT] [--plot PNG]
 
 Probes (the scene's): fluid.p0 .. p4, the pressure on the axis at z = 0, 1.25, 2.5, 3.75, 5 cm;
-solid.r0_x .. r4_x, the wall's radial displacement at (r_i, 0, z) (x is radial there).
+solid.r0_x .. r4_x, the wall's radial displacement at (r_i, 0, z) (x is radial there); in the 2D
+analogue (configs/tube_2d.yaml) solid.r0_y .. r4_y, the wall's displacement across the channel.
 Definitions (CGS, as the scene):
   peak      the largest value of the probe over the run and the time it is reached;
   arrival   the first time the probe reaches half of its peak, interpolated linearly between
@@ -37,10 +38,11 @@ def read(run):
         sys.exit(f"{path}: no rows")
     t = [float(r["time"]) for r in rows]
     cols = {}
+    radial = "x" if "solid.r0_z" in rows[0] else "y"  # the tube: x is radial at (r, 0, z); tube_2d: y
     for i in range(5):
-        for name, key in ((f"p{i}", f"fluid.p{i}"), (f"r{i}", f"solid.r{i}_x")):
+        for name, key in ((f"p{i}", f"fluid.p{i}"), (f"r{i}", f"solid.r{i}_{radial}")):
             if key not in rows[0]:
-                sys.exit(f"{path}: no column {key} (a run of configs/tube_3d.yaml?)")
+                sys.exit(f"{path}: no column {key} (a run of configs/tube_3d.yaml or tube_2d.yaml?)")
             cols[name] = [float(r[key]) for r in rows]
     return t, cols
 
