@@ -279,6 +279,22 @@ const char* scheme_name(TimeScheme scheme) {
 
 // --- boundary conditions ---
 
+// The time factor of an inflow entry, 2D and 3D: the ramp 0.5 (1 - cos(pi t / ramp_time)) up to
+// ramp_time, times pulsation {mean, amplitude, frequency}'s mean + amplitude sin(2 pi f t).
+std::function<double(double)> inflow_time_factor(const schema::Reader& inflow) {
+  const double ramp = inflow.get<double>("ramp_time");
+  double pulse_mean = 1.0, pulse_amplitude = 0.0, pulse_frequency = 0.0;
+  if (auto pulse = inflow.optional_child("pulsation")) {
+    pulse_mean = pulse->get<double>("mean");
+    pulse_amplitude = pulse->get<double>("amplitude");
+    pulse_frequency = pulse->get<double>("frequency");
+  }
+  return [=](double t) {
+    return ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
+           (pulse_mean + pulse_amplitude * std::sin(2 * M_PI * pulse_frequency * t));
+  };
+}
+
 // The velocity of an inflow entry on `group`: a parabolic or uniform profile along the
 // group's extent (or profile_extent), optionally ramped and pulsating.
 VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& mesh, const std::string& group) {
@@ -291,7 +307,6 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
   else
     inflow.fail("max_velocity", "give max_velocity or mean_velocity");
   const Eigen::Vector2d direction = vector2(inflow, "direction").normalized();
-  const double ramp = inflow.get<double>("ramp_time");
   // Extent of the inlet along its tangent.
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = Eigen::Vector2d::Constant(-1e300);
   for (int i : mesh.boundary_nodes({group})) {
@@ -310,13 +325,7 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
   }
   const Eigen::Vector2d tangent = (hi - lo).normalized();
   const double width = (hi - lo).norm();
-  // pulsation: {mean, amplitude, frequency} multiplies the profile by mean + amplitude sin(2 pi f t).
-  double pulse_mean = 1.0, pulse_amplitude = 0.0, pulse_frequency = 0.0;
-  if (auto pulse = inflow.optional_child("pulsation")) {
-    pulse_mean = pulse->get<double>("mean");
-    pulse_amplitude = pulse->get<double>("amplitude");
-    pulse_frequency = pulse->get<double>("frequency");
-  }
+  const auto time_factor = inflow_time_factor(inflow);
   std::function<double(double)> shape;
   if (profile == "parabolic")
     shape = [](double s) { return 4 * s * (1 - s); };
@@ -324,9 +333,7 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
     shape = [](double) { return 1.0; };
   return [=](const Eigen::Vector2d& x, double t) -> Eigen::Vector2d {
     const double s = std::clamp((x - lo).dot(tangent) / width, 0.0, 1.0);
-    const double factor = ((ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0) *
-                          (pulse_mean + pulse_amplitude * std::sin(2 * M_PI * pulse_frequency * t));
-    return umax * factor * shape(s) * direction;
+    return umax * time_factor(t) * shape(s) * direction;
   };
 }
 
@@ -436,7 +443,7 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
     const bool parabolic = inflow.get<std::string>("profile") == "parabolic";
     const double umax = inflow.has("max_velocity") ? inflow.get<double>("max_velocity")
                                                    : (parabolic ? 2.25 : 1.0) * inflow.get<double>("mean_velocity");
-    const double ramp = inflow.get<double>("ramp_time");
+    const auto time_factor = inflow_time_factor(inflow);
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
     for (int n : m.boundary_nodes({group})) {
       lo = lo.cwiseMin(m.nodes.row(n).transpose());
@@ -450,8 +457,7 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
             const double s = std::clamp((x(c) - lo(c)) / (hi(c) - lo(c)), 0.0, 1.0);
             shape *= 4 * s * (1 - s);
           }
-      const double factor = (ramp > 0 && t < ramp) ? 0.5 * (1 - std::cos(M_PI * t / ramp)) : 1.0;
-      return umax * factor * shape * direction;
+      return umax * time_factor(t) * shape * direction;
     });
   }
   for (const auto& g : string_list(section, "walls")) {
