@@ -37,8 +37,8 @@ Block make_block(int dim, double k, double T, bool normal_only) {
     b.system = std::make_unique<SolidSystem>(b.mesh, make_material<2>("neo_hookean", c), 1.0, b.fixed);
   else
     b.system = std::make_unique<SolidSystem>(b.mesh, make_material<3>("neo_hookean", c), 1.0, b.fixed);
-  b.system->set_support(std::make_shared<ElasticSupport>(
-      b.mesh, std::vector<SupportSpec>{{b.mesh.facets({"bottom"}), k, normal_only}}));
+  b.system->set_support(
+      std::make_shared<ElasticSupport>(b.mesh, std::vector<SupportSpec>{{b.mesh.facets({"bottom"}), k, normal_only}}));
   const Eigen::VectorXd top = lumped_facet_measure(b.mesh, b.mesh.facets({"top"}));
   b.load = Eigen::VectorXd::Zero(dim * n);
   for (int i = 0; i < n; ++i) b.load(dim * i + 1) = -T * top(i);
