@@ -18,6 +18,7 @@ under test, with /usr/bin first on PATH (Debian's python3). The test fails when 
 exits non-zero, times out, or is in neither table (the docs changed: add it to a table).
 
   run_doc_commands.py --source SRC --build BUILD [--only FILE...] [--list] [--keep]
+  run_doc_commands.py --source SRC --check-tables
 """
 import argparse
 import glob
@@ -254,6 +255,9 @@ def main():
     ap.add_argument("--only", nargs="+", help="these documents only (e.g. README.md docs/runs.md)")
     ap.add_argument("--list", action="store_true", help="print each command and what happens to it; run nothing")
     ap.add_argument("--keep", action="store_true", help="keep the working folders")
+    ap.add_argument("--check-tables", action="store_true",
+                    help="run nothing; fail when a command of the documents is in neither table or in both, "
+                         "or a table entry is in no document")
     a = ap.parse_args()
     source = a.source.resolve()
     found = commands(source, a.only or DOCS)
@@ -271,10 +275,14 @@ def main():
                         f"so it takes seconds) or to SKIP (with the reason) in tests/docs/run_doc_commands.py")
     for c in both:
         failures.append(f"`{c}` is in both RUN and SKIP")
-    if not a.only:
-        for c in list(RUN) + list(SKIP):
-            if c not in seen:
-                print(f"note: table entry no longer in the docs: `{c}`")
+    stale = [c for c in list(RUN) + list(SKIP) if c not in seen] if not a.only else []
+    for c in stale:
+        print(f"note: table entry no longer in the docs: `{c}`")
+    if a.check_tables:
+        failures += [f"`{c}` is in a table but in no document: remove it" for c in stale]
+        print("\n".join(["FAILED:"] + failures) if failures else
+              f"{len(found)} documented commands, each in exactly one table; no stale entry")
+        return 1 if failures else 0
     if a.build is None:
         ap.error("--build is required to run the commands")
     build = a.build.resolve()
