@@ -36,7 +36,9 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
     if (std::find(known.begin(), known.end(), key) == known.end())
       throw ConfigError(fmt::format("{}: unknown top-level section '{}' (known: {})", scene_.root().where(key), key,
                                     fmt::join(known, ", ")));
-  if (settings_.predictor != "previous")
+  // The warning is for loosely coupled runs (a fixed number of iterations): converged
+  // iterations take the unconverged modes down whatever the predictor.
+  if (settings_.predictor != "previous" && settings_.tolerance <= 0)
     log->warn(
         "predictor '{}' ({}) can excite interface modes the iterations leave unconverged (docs/fsi.md); "
         "'previous' is the paper's and the robust choice",
