@@ -459,7 +459,7 @@ class FlagSolid:
         """solid_server's tube (mesh.cpp, tube_mesh): a straight tube along z, 'divisions':
         [n_theta around, n_r through the wall, n_z along]; the same nodes and hexahedra (or each
         hexahedron cut into 6 tetrahedra about its diagonal); facet sets inner, outer, start, end."""
-        origin = m.vector("origin", 3, [0.0, 0.0, 0.0])
+        origin = m.vector("origin", 3, required=True)
         ri = m.number("inner_radius", required=True, positive=True)
         ro = m.number("outer_radius", required=True, positive=True)
         length = m.number("length", required=True, positive=True)
