@@ -98,6 +98,11 @@ RUN = {
     # docs/fluid.md: DFG 3D-3Z, 5 of its 800 steps; the statistics of that run.
     "build/bin/fsi run configs/dfg_3d3z.yaml --out runs/dfg_3d3z": ("append", "--set time.end=0.05"),
     "/usr/bin/python3 bench/fluid/dfg_3d3z.py runs/dfg_3d3z": None,
+    # docs/fsi3d.md: the same coarse tube with the FEniCS solid as its wall, against the run above.
+    'build/bin/fsi run configs/tube_3d.yaml --out runs/tube_fenics --solid-command '
+    '"python3 python/examples/fenics_solid/fenics_solid.py"':
+        ("append", "--set time.end=0.0006 --set fluid.mesh.size=0.5 --set 'solid.mesh.divisions=[12, 1, 10]'"),
+    "/usr/bin/python3 bench/fsi/tube_waves.py runs/tube_fenics --reference runs/tube": None,
     # docs/fsi3d.md: the tube's 2D analogue, 10 of its 100 steps; the wave analysis of that run.
     "build/bin/fsi run configs/tube_2d.yaml --out runs/tube_2d": ("append", "--set time.end=0.001"),
     "/usr/bin/python3 bench/fsi/tube_waves.py runs/tube_2d": None,

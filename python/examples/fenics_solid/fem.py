@@ -2,7 +2,7 @@
 protocol here (fenics_solid.py serves it through fsi.server).
 
 A total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible neo-Hookean), 2D
-plane strain or 3D, the dimension taken from the mesh (`rectangle` or `box`; one code path for
+plane strain or 3D, the dimension taken from the mesh (`rectangle`, `box` or `tube`; one code path for
 both: Identity(dim), V.sub(c) for each component), Lagrange elements on triangles /
 tetrahedra (P1, P2, ...) or quadrilaterals / hexahedra (Q1), full Newton with the consistent
 tangent that UFL derives, and the time schemes of solid_server:
@@ -132,11 +132,39 @@ class Section:
             raise SceneError(f"unknown key(s) in '{self.where}': {', '.join(unknown)}")
 
 
+TUBE_FACET_SETS = ("inner", "outer", "start", "end")
+
+
+def tube_mesh(origin, r_inner, r_outer, length, n_theta, n_r, n_z):
+    """solid_server's tube_mesh (solid_server/core/src/mesh.cpp): node (i radial, j around,
+    k along) is (k n_theta + j) (n_r + 1) + i at (r_i cos theta_j, r_i sin theta_j, z_k) from
+    the origin. Returns (nodes, hexahedra in DOLFIN's tensor-product vertex order: vertex a at
+    (i, j, k) + bits of a, i.e. solid_server's (r, theta, z) hexahedron 0 1 2 3 4 5 6 7 as
+    0 1 3 2 4 5 7 6, the same cells in the same order), (i, j, k) of each node)."""
+    k, j, i = np.meshgrid(np.arange(n_z + 1), np.arange(n_theta), np.arange(n_r + 1), indexing="ij")
+    ijk = np.stack([i.ravel(), j.ravel(), k.ravel()], axis=1)
+    r = r_inner + (r_outer - r_inner) * ijk[:, 0] / n_r
+    theta = 2 * math.pi * ijk[:, 1] / n_theta
+    nodes = np.stack([origin[0] + r * np.cos(theta), origin[1] + r * np.sin(theta),
+                      origin[2] + length * ijk[:, 2] / n_z], axis=1)
+
+    def node(i, j, k):
+        return (k * n_theta + j % n_theta) * (n_r + 1) + i
+
+    # DOLFIN takes a hexahedron whose vertex numbers rise in its own order only; the last cell
+    # around (j + 1 = 0) is numbered from its j + 1 side, its second axis pointing to -theta
+    # (a left-handed cell: DOLFIN integrates with |det J|)
+    cells = [[node(i + di, (j + dj) if j < n_theta - 1 else (j + 1 - dj), k + dk)
+              for dk in (0, 1) for dj in (0, 1) for di in (0, 1)]
+             for k in range(n_z) for j in range(n_theta) for i in range(n_r)]
+    return nodes, np.array(cells, dtype=np.int64), ijk
+
+
 # -- the model ----------------------------------------------------------------------------------
 class FlagSolid:
     """The solid of one run: mesh, function space, forms, state (d, v, a of the last accepted
     step and of the current solve) and the interface, in 2D or 3D (`dim`, from the mesh:
-    `rectangle` or `box`). All vectors are numpy arrays over the DOLFIN dofs of V (`dim`
+    `rectangle`, `box` or `tube`). All vectors are numpy arrays over the DOLFIN dofs of V (`dim`
     components interleaved by DOLFIN's dof map, not necessarily x0 y0 x1 y1: `comp[:, c]` are
     the dofs of component c, node by node; `ix`, `iy`, `iz` the same by name)."""
 
@@ -148,6 +176,7 @@ class FlagSolid:
     # the same numbers) and its enhanced-strain variant (no enhanced strains here: refused in
     # 2D as always; accepted with a line in the log in 3D, so that solid_server's 3D scenes run)
     SERVER_ELEMENTS = {2: ("q4", "q4_eas"), 3: ("hex8", "h8_eas")}
+    MESH_DIM = {"rectangle": 2, "box": 3, "tube": 3}
 
     def __init__(self, section, dt, interface_damping, log=print, element=None):
         self.log = log
@@ -159,14 +188,14 @@ class FlagSolid:
         self.dt = dt
         self.gamma = float(interface_damping)
 
-        # 0. The dimension, from the mesh: rectangle (2D) or box (3D).
+        # 0. The dimension, from the mesh: rectangle (2D), box or tube (3D).
         m = s.child("mesh")
         mtype = m.get("type", "rectangle")
-        if mtype not in ("rectangle", "box"):
-            raise SceneError(f"'solid.mesh.type: {mtype}': this solid builds only 'rectangle' (2D) and 'box' (3D) "
-                             f"meshes")
-        dim = self.dim = 2 if mtype == "rectangle" else 3
-        self.facet_sets = self.FACET_SETS[:2 * dim]
+        if mtype not in self.MESH_DIM:
+            raise SceneError(f"'solid.mesh.type: {mtype}': this solid builds only 'rectangle' (2D), 'box' and 'tube' "
+                             f"(3D) meshes")
+        dim = self.dim = self.MESH_DIM[mtype]
+        self.facet_sets = TUBE_FACET_SETS if mtype == "tube" else self.FACET_SETS[:2 * dim]
 
         # 1. The discretisation: solid.fenics, else `element` (the server's command line), else
         #    Q1 quadrilaterals (hexahedra in 3D) with 2 x 2 (x 2) Gauss points, solid_server's own
@@ -205,29 +234,12 @@ class FlagSolid:
             raise SceneError(f"'solid.linear_solver' must be cholmod, umfpack or superlu, got {linear!r} "
                              f"(this solid always uses SuperLU)")
 
-        # 2. Mesh: the structured rectangle / box of solid_server ('elements' / 'divisions':
-        #    cells per direction).
-        origin = m.vector("origin", dim, required=True)
-        size = m.vector("size", dim, required=True)
-        if not all(x > 0 for x in size):
-            raise SceneError("'solid.mesh.size' must be positive")
-        cells_key = "elements" if dim == 2 else "divisions"
-        ne = m.get(cells_key, required=True)
-        if not (isinstance(ne, list) and len(ne) == dim
-                and all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in ne)):
-            raise SceneError(f"'solid.mesh.{cells_key}' must be [{', '.join('nx ny nz'.split()[:dim])}] (positive "
-                             f"integers), got {ne!r}")
-        m.check_all_used()
-        self.box = tuple(origin) + tuple(o + l for o, l in zip(origin, size))
-        p0, p1 = df.Point(*origin), df.Point(*(o + l for o, l in zip(origin, size)))
-        if dim == 2 and self.tensor:
-            self.mesh = df.RectangleMesh.create([p0, p1], ne, df.CellType.Type.quadrilateral)
-        elif dim == 2:
-            self.mesh = df.RectangleMesh(p0, p1, ne[0], ne[1], diagonal)
-        elif self.tensor:
-            self.mesh = df.BoxMesh.create([p0, p1], ne, df.CellType.Type.hexahedron)
-        else:  # each hexahedron cut into 6 tetrahedra
-            self.mesh = df.BoxMesh(p0, p1, ne[0], ne[1], ne[2])
+        # 2. Mesh: the structured rectangle / box / tube of solid_server, with its facet sets as
+        #    markers 1, 2, ... in the order of self.facet_sets.
+        if mtype == "tube":
+            self.mesh, self.markers = self._tube(m)
+        else:
+            self.mesh, self.markers = self._rectangle_or_box(m, dim, diagonal)
         family = "Q" if self.tensor else "CG"
         self.V = df.VectorFunctionSpace(self.mesh, family, self.degree)
         self.n = self.V.dim()
@@ -240,14 +252,7 @@ class FlagSolid:
         if not all(np.allclose(coords[self.comp[:, c]], self.node_xy) for c in range(1, dim)):
             raise RuntimeError("the components' dofs of V are not paired node by node")
 
-        # Facet sets of the rectangle / box: markers 1..2 dim = left, right, bottom, top (, back, front).
-        h = 1e-9 * max(size)
-        self.markers = df.MeshFunction("size_t", self.mesh, dim - 1, 0)
-        for i, name in enumerate(self.facet_sets):
-            axis, value = i // 2, origin[i // 2] + (size[i // 2] if i % 2 else 0.0)
-            df.CompiledSubDomain(f"near(x[{axis}], {value!r}, {h!r}) && on_boundary").mark(self.markers, i + 1)
-
-        shape = "rectangle" if dim == 2 else "box"
+        shape = mtype
 
         def edge_ids(key, names):
             bad = [x for x in names if x not in self.facet_sets]
@@ -417,6 +422,83 @@ class FlagSolid:
         self.K = df.PETScMatrix()
         self.R = df.PETScVector()
         self._u_array = df.as_backend_type(self.u.vector()).vec().array
+
+    # -- meshes -------------------------------------------------------------------------------
+    def _rectangle_or_box(self, m, dim, diagonal):
+        """solid_server's structured rectangle / box ('elements' / 'divisions': cells per
+        direction); facet sets left, right, bottom, top (, back, front)."""
+        origin = m.vector("origin", dim, required=True)
+        size = m.vector("size", dim, required=True)
+        if not all(x > 0 for x in size):
+            raise SceneError("'solid.mesh.size' must be positive")
+        cells_key = "elements" if dim == 2 else "divisions"
+        ne = m.get(cells_key, required=True)
+        if not (isinstance(ne, list) and len(ne) == dim
+                and all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in ne)):
+            raise SceneError(f"'solid.mesh.{cells_key}' must be [{', '.join('nx ny nz'.split()[:dim])}] (positive "
+                             f"integers), got {ne!r}")
+        m.check_all_used()
+        p0, p1 = df.Point(*origin), df.Point(*(o + l for o, l in zip(origin, size)))
+        if dim == 2 and self.tensor:
+            mesh = df.RectangleMesh.create([p0, p1], ne, df.CellType.Type.quadrilateral)
+        elif dim == 2:
+            mesh = df.RectangleMesh(p0, p1, ne[0], ne[1], diagonal)
+        elif self.tensor:
+            mesh = df.BoxMesh.create([p0, p1], ne, df.CellType.Type.hexahedron)
+        else:  # each hexahedron cut into 6 tetrahedra
+            mesh = df.BoxMesh(p0, p1, ne[0], ne[1], ne[2])
+        # markers 1..2 dim = left, right, bottom, top (, back, front)
+        h = 1e-9 * max(size)
+        markers = df.MeshFunction("size_t", mesh, dim - 1, 0)
+        for i, name in enumerate(self.facet_sets):
+            axis, value = i // 2, origin[i // 2] + (size[i // 2] if i % 2 else 0.0)
+            df.CompiledSubDomain(f"near(x[{axis}], {value!r}, {h!r}) && on_boundary").mark(markers, i + 1)
+        return mesh, markers
+
+    def _tube(self, m):
+        """solid_server's tube (mesh.cpp, tube_mesh): a straight tube along z, 'divisions':
+        [n_theta around, n_r through the wall, n_z along]; the same nodes and hexahedra (or each
+        hexahedron cut into 6 tetrahedra about its diagonal); facet sets inner, outer, start, end."""
+        origin = m.vector("origin", 3, required=True)
+        ri = m.number("inner_radius", required=True, positive=True)
+        ro = m.number("outer_radius", required=True, positive=True)
+        length = m.number("length", required=True, positive=True)
+        if not ro > ri:
+            raise SceneError(f"'solid.mesh.outer_radius' ({ro}) must be larger than 'inner_radius' ({ri})")
+        ne = m.get("divisions", required=True)
+        if not (isinstance(ne, list) and len(ne) == 3 and all(isinstance(n, int) and not isinstance(n, bool) for n in ne)
+                and ne[0] >= 3 and ne[1] >= 1 and ne[2] >= 1):
+            raise SceneError(f"'solid.mesh.divisions' must be [n_theta >= 3, n_r >= 1, n_z >= 1] (integers), got {ne!r}")
+        m.check_all_used()
+        nodes, cells, ijk = tube_mesh(origin, ri, ro, length, *ne)
+        if not self.tensor:  # Kuhn's split, about the diagonal 0-7: conforming across the faces
+            cells = cells[:, [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7],
+                              [0, 4, 6, 7]]].reshape(-1, 4)
+        mesh = df.Mesh()
+        editor = df.MeshEditor()
+        editor.open(mesh, self.cell, 3, 3)
+        editor.init_vertices(len(nodes))
+        editor.init_cells(len(cells))
+        for v, x in enumerate(nodes):
+            editor.add_vertex(v, x)
+        for c, verts in enumerate(cells):
+            editor.add_cell(c, verts.astype(np.uintp))
+        editor.close(not self.tensor)  # DOLFIN cannot reorder hexahedra (they are in its order already)
+        # a boundary facet belongs to the set whose nodes carry all its vertices
+        n_theta, n_r, n_z = ne
+        mesh.init(2, 3)
+        markers = df.MeshFunction("size_t", mesh, 2, 0)
+        tests = ((0, 0), (0, n_r), (2, 0), (2, n_z))  # inner, outer, start, end: (index, value) of (i, j, k)
+        arr = markers.array()
+        for f in df.facets(mesh):
+            if f.num_entities(3) != 1:
+                continue
+            v = ijk[f.entities(0)]
+            for s_id, (axis, value) in enumerate(tests):
+                if np.all(v[:, axis] == value):
+                    arr[f.index()] = s_id + 1
+                    break
+        return mesh, markers
 
     # -- helpers ----------------------------------------------------------------------------
     @staticmethod

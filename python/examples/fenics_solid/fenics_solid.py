@@ -1,18 +1,19 @@
 #!/usr/bin/env python3
 """A FEniCS (legacy DOLFIN) finite-element solid served through fsi.server: it replaces
-solid_server in any scene whose solid is a structured rectangle (2D, e.g. the Turek-Hron flag)
-or box (3D: the dimension is the mesh's).
+solid_server in any scene whose solid is a structured rectangle (2D, e.g. the Turek-Hron flag),
+box or tube (3D: the dimension is the mesh's).
 
     fsi run python/examples/fenics_solid/scenes/csm1.yaml --out runs/csm1_fenics \\
         --solid-command "python3 python/examples/fenics_solid/fenics_solid.py --cell triangle --degree 2"
     fsi run configs/block_3d.yaml --out runs/block_3d_fenics \\
         --solid-command "python3 python/examples/fenics_solid/fenics_solid.py"
 
-It reads the same `solid` section as solid_server's `model: fem` (mesh rectangle or box,
+It reads the same `solid` section as solid_server's `model: fem` (mesh rectangle, box or tube,
 material, density, gravity, analysis, time_scheme, load_steps, clamp, supports, interface,
 tractions, point_loads, probes, newton, output_every), so one scene runs with either solid.
 In 3D the interface is sent as faces (dimension 3): Q1 hexahedra (the default on a box) give
-4-node faces, `--cell tetrahedron --degree 1|2` 3- or 6-node triangles. The element is this
+4-node faces, `--cell tetrahedron --degree 1|2` 3- or 6-node triangles (each hexahedron of the
+box or tube cut into 6 tetrahedra). The element is this
 solid's own choice: `--cell triangle --degree 2` (accurate on coarse meshes), or a section
 `solid.fenics: {cell, degree, diagonal, quadrature_degree}` in a scene written for it alone
 (solid_server refuses the key). By default it uses solid_server's element (Q1, 2 x 2 Gauss
@@ -140,11 +141,11 @@ def main():
     parser = fs.argument_parser(__doc__.splitlines()[0])
     g = parser.add_argument_group("the element (defaults of the scene's solid.fenics, which wins when present)")
     g.add_argument("--cell", choices=("quadrilateral", "triangle", "hexahedron", "tetrahedron"),
-                   help="default quadrilateral (2D, mesh type rectangle) / hexahedron (3D, mesh type box)")
+                   help="default quadrilateral (2D, mesh type rectangle) / hexahedron (3D, mesh type box or tube)")
     g.add_argument("--degree", type=int, help="Lagrange degree (default 1; quadrilaterals and hexahedra: 1 only)")
     g.add_argument("--diagonal", choices=("crossed", "right", "left", "right/left", "left/right"),
                    help="how the rectangles of solid.mesh.elements are cut into triangles (default crossed; "
-                        "2D only: a box's cells are cut into 6 tetrahedra each)")
+                        "2D only: the cells of a box or tube are cut into 6 tetrahedra each)")
     g.add_argument("--quadrature-degree", type=int, help="default 2 on quadrilaterals / hexahedra (2 x 2 (x 2) "
                                                            "Gauss), 2 x degree on triangles / tetrahedra")
     args = parser.parse_args()
