@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "fsi/common/gmsh_reader.hpp"
+#include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/navier_stokes_fluid.hpp"
 
 namespace {
@@ -166,4 +167,92 @@ TEST(Nitsche, InterfaceMassIsThePenaltyOperatorInItsConfiguration) {
   const double start = interface_mass_after_dilation(true);
   EXPECT_NEAR(current / start, 1.01, 1e-12);                     // the polygon's perimeter scales exactly
   EXPECT_NEAR(start, 2 * M_PI * 0.05, 0.002 * 2 * M_PI * 0.05);  // the undeformed circle (polygon)
+}
+
+// The Robin interface condition of the explicit Robin-Neumann coupling (FlowSolver::solve with
+// a RobinCondition), both elements. Plane Couette flow in [0, 2] x [0, 1]: walls left, right
+// and bottom strong (u = (U y, 0)), Robin on the top. sigma n = (mu U, -p) there, so the
+// condition sigma n + alpha v = alpha v* + t* with v* = (V, 0), t* = (tau, -p0) has the exact
+// solution u = (U y, 0), p = p0, U = (alpha V + tau) / (alpha + mu), which both elements
+// reproduce to round-off (linear velocity, constant pressure). Then arbitrary nodal v* and f*:
+// the lumped identity f_sigma_j + A_j v_j = A_j v*_j + f*_j at every node without a strong
+// condition, to solver tolerance.
+TEST(Robin, CouetteFlowAndTheLumpedIdentityOnBothElements) {
+  const double mu = 0.1, alpha = 2.0, V = 1.0, tau = 0.05, p0 = 0.7;
+  const double U = (alpha * V + tau) / (alpha + mu);
+  const auto mesh = FluidMesh::rectangle(0, 2, 0, 1, 8, 4);
+  for (const char* element : {"p1p1", "p2p1"}) {
+    SCOPED_TRACE(element);
+    FlowParameters p;
+    p.viscosity = mu;
+    p.scheme = TimeScheme::BDF1;
+    p.max_iterations = 30;
+    p.tolerance = 1e-13;
+    p.nitsche_penalty = 100;        // Nitsche's terms: not in a Robin solve
+    p.reuse_factorisation = false;  // direct solves: the identity to round-off
+    FlowSolver s(mesh, p, element);
+    const auto couette = [U](const Eigen::Vector2d& x, double) { return Eigen::Vector2d(U * x.y(), 0); };
+    for (const char* wall : {"left", "right", "bottom"}) s.add_dirichlet(wall, couette);
+    s.set_interface({"top"});
+    const auto& nodes = s.mesh().nodes;
+    Eigen::MatrixX2d initial(nodes.rows(), 2);
+    for (Eigen::Index i = 0; i < nodes.rows(); ++i) initial.row(i) = couette(nodes.row(i).transpose(), 0).transpose();
+    s.set_initial_velocity(initial);
+    const auto n = static_cast<Eigen::Index>(s.interface_nodes().size());
+    const Eigen::VectorXd lumped = Eigen::MatrixXd(s.interface_mass()).rowwise().sum();  // int N_j
+    EXPECT_NEAR(lumped.sum(), 2.0, 1e-12);
+    fsi::RobinCondition r;
+    r.coefficient = Eigen::VectorXd::Constant(n, alpha);
+    r.velocity = Eigen::VectorXd::Zero(2 * n);
+    r.traction = Eigen::VectorXd::Zero(2 * n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      r.velocity(2 * j) = V;
+      r.traction.segment<2>(2 * j) = lumped(j) * Eigen::Vector2d(tau, -p0);
+    }
+    s.solve_robin(0.1, 0.1, nodes, r);
+    const auto v = s.velocity();
+    for (Eigen::Index i = 0; i < nodes.rows(); ++i) {
+      EXPECT_NEAR(v(i, 0), U * nodes(i, 1), 1e-11);
+      EXPECT_NEAR(v(i, 1), 0, 1e-11);
+    }
+    EXPECT_NEAR((s.pressure().array() - p0).abs().maxCoeff(), 0, 1e-10);
+    // f_sigma = int N_j sigma n, exactly (the reaction; no penalty part), at the nodes without
+    // a strong condition (the two corners' reactions hold the walls' too).
+    const Eigen::VectorXd f = s.interface_traction();
+    const auto free = [&](Eigen::Index j) {
+      const double x = nodes(s.interface_nodes()[static_cast<std::size_t>(j)], 0);
+      return x > 1e-12 && x < 2 - 1e-12;
+    };
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (!free(j)) continue;
+      EXPECT_NEAR(f(2 * j), mu * U * lumped(j), 1e-11);
+      EXPECT_NEAR(f(2 * j + 1), -p0 * lumped(j), 1e-11);
+    }
+
+    // Arbitrary nodal data (a later step): the identity holds node by node.
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double x = nodes(s.interface_nodes()[static_cast<std::size_t>(j)], 0);
+      r.coefficient(j) = alpha * (1 + 0.5 * x);
+      r.velocity.segment<2>(2 * j) << std::sin(3 * x), 0.2 * std::cos(2 * x);
+      r.traction.segment<2>(2 * j) << 0.01 * x, -0.05 * (1 + x * x);
+    }
+    s.accept();
+    s.solve_robin(0.2, 0.1, nodes, r);
+    const Eigen::VectorXd fs = s.interface_traction();
+    int checked = 0;
+    double worst = 0, scale = 0;
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (!free(j)) continue;
+      const int node = s.interface_nodes()[static_cast<std::size_t>(j)];
+      const double a = r.coefficient(j) * lumped(j);
+      const Eigen::Vector2d lhs = fs.segment<2>(2 * j) + a * s.velocity().row(node).transpose();
+      const Eigen::Vector2d rhs = a * r.velocity.segment<2>(2 * j) + r.traction.segment<2>(2 * j);
+      worst = std::max(worst, (lhs - rhs).cwiseAbs().maxCoeff());
+      scale = std::max(scale, rhs.cwiseAbs().maxCoeff());
+      ++checked;
+    }
+    EXPECT_EQ(checked, std::string(element) == "p1p1" ? 7 : 15);
+    EXPECT_LT(worst, 1e-12 * scale);
+    EXPECT_GT(s.velocity().col(1).cwiseAbs().maxCoeff(), 1e-3);  // the data did move the fluid
+  }
 }

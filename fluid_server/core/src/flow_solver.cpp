@@ -310,7 +310,8 @@ struct BasicFlowSolver<Dim>::Step {
   Eigen::VectorXd U_lin;    // linearisation velocity of the first iteration
   Eigen::VectorXd history;  // (alpha1 u_n + alpha2 u_{n-1}) / dt
   StrongConstraints constraints;
-  bool retrial = false;  // a repeated solve of the time level: start from its last solution
+  bool retrial = false;                   // a repeated solve of the time level: start from its last solution
+  const RobinCondition* robin = nullptr;  // a Robin interface condition instead of Nitsche's terms
 };
 
 template <int Dim>
@@ -550,12 +551,30 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
   }
   std::copy(im.volume.valuePtr(), im.volume.valuePtr() + im.volume.nonZeros(), im.matrix.valuePtr());
   im.rhs = im.rhs_volume;
-  // Nitsche terms on the interface.
-  const detail::NitscheInputT<Dim> nitsche{X_, X_n_, interface_velocity_, params_};
-  detail::LocalSystem s;
-  for (const auto& edge : im.edges) {
-    im.element->nitsche(edge, nitsche, s);
-    im.add(edge.element, s, im.matrix.valuePtr(), im.rhs);
+  if (step.robin) {
+    // The Robin condition, lumped: A_j (v_j - v*_j) - f*_j on node j's momentum rows, A_j =
+    // coefficient_j int N_j (the interface mass's row sum on the current interface).
+    const RobinCondition& r = *step.robin;
+    std::vector<Eigen::Triplet<double>> t;
+    for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
+    Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
+    for (const auto& e : t) lumped(e.row()) += e.value();
+    for (Eigen::Index j = 0; j < lumped.size(); ++j) {
+      const double a = r.coefficient(j) * lumped(j);
+      for (int c = 0; c < Dim; ++c) {
+        const int k = im.dof.velocity(interface_nodes_[static_cast<std::size_t>(j)], c);
+        im.matrix.coeffRef(k, k) += a;
+        im.rhs(k) += a * r.velocity(Dim * j + c) + r.traction(Dim * j + c);
+      }
+    }
+  } else {
+    // Nitsche terms on the interface.
+    const detail::NitscheInputT<Dim> nitsche{X_, X_n_, interface_velocity_, params_};
+    detail::LocalSystem s;
+    for (const auto& edge : im.edges) {
+      im.element->nitsche(edge, nitsche, s);
+      im.add(edge.element, s, im.matrix.valuePtr(), im.rhs);
+    }
   }
   apply_constraints(im.matrix, im.rhs, step.constraints);
   report.assembly_seconds += seconds_since(t_assembly);
@@ -564,9 +583,29 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
 template <int Dim>
 StepReport BasicFlowSolver<Dim>::solve(double time, double dt, const Nodes& positions,
                                        const Eigen::VectorXd& interface_velocity) {
+  Step step = begin_step(time, dt, positions, interface_velocity);
+  return solve(step);
+}
+
+template <int Dim>
+StepReport BasicFlowSolver<Dim>::solve_robin(double time, double dt, const Nodes& positions,
+                                             const RobinCondition& robin) {
+  const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
+  if (robin.coefficient.size() != n || robin.velocity.size() != Dim * n || robin.traction.size() != Dim * n)
+    throw std::invalid_argument(fmt::format(
+        "Robin condition: {} coefficients, {} velocities and {} tractions for {} interface nodes (expected {}, {}, {})",
+        robin.coefficient.size(), robin.velocity.size(), robin.traction.size(), n, n, Dim * n, Dim * n));
+  Step step = begin_step(time, dt, positions, robin.velocity);
+  step.robin = &robin;
+  return solve(step);
+}
+
+template <int Dim>
+StepReport BasicFlowSolver<Dim>::solve(Step& step) {
   StepReport report;
   auto& im = *impl_;
-  Step step = begin_step(time, dt, positions, interface_velocity);
+  const double time = step.time;
+  robin_ = step.robin != nullptr;
   Eigen::VectorXd& U_lin = step.U_lin;
   double previous_change = std::numeric_limits<double>::infinity();
   for (int iteration = 1; iteration <= std::max(1, params_.max_iterations); ++iteration) {
@@ -774,6 +813,7 @@ Eigen::VectorXd BasicFlowSolver<Dim>::interface_traction() const {
   for (Eigen::Index i = 0; i < ni; ++i)
     f.template segment<Dim>(Dim * i) =
         reaction_.template segment<Dim>(impl_->dof.velocity(interface_nodes_[static_cast<std::size_t>(i)], 0));
+  if (robin_) return f;
   // + gamma_N1 int N^T (v_f - v_s) = gamma_N1 (f_v - M_f v_s)
   return f +
          params_.nitsche_penalty * (interface_velocity_integral() - apply_nodal(interface_mass(), interface_velocity_));

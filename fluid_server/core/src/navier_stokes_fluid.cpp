@@ -964,7 +964,7 @@ FluidLoads NavierStokesFluid::initial_loads(const Eigen::VectorXd&, const Eigen:
 // One solve on the current mesh, moved by the interface displacement (after a remesh measured
 // from the mesh of the remesh).
 void NavierStokesFluid::solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
-                                      const Eigen::VectorXd& interface_velocity) {
+                                      const Eigen::VectorXd& interface_velocity, const RobinCondition* robin) {
   Eigen::MatrixX2d positions = solver_->mesh().nodes;
   if (motion_ && interface_displacement.size() > 0) {
     const Eigen::VectorXd d = remesh_offset_.size() == interface_displacement.size()
@@ -973,11 +973,23 @@ void NavierStokesFluid::solve_on_mesh(const StepInfo& info, const Eigen::VectorX
     positions += extend(d);
     last_interface_displacement_ = d;
   }
-  last_report_ = solver_->solve(info.time, info.dt, positions, interface_velocity);
+  last_report_ = robin ? solver_->solve_robin(info.time, info.dt, positions, *robin)
+                       : solver_->solve(info.time, info.dt, positions, interface_velocity);
 }
 
 FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                          const Eigen::VectorXd& interface_velocity) {
+  return solve(info, interface_displacement, interface_velocity, nullptr);
+}
+
+FluidLoads NavierStokesFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                                          const RobinCondition& robin) {
+  if (!solver_) return FluidModel::solve_robin(info, interface_displacement, robin);  // (3D: throws)
+  return solve(info, interface_displacement, Eigen::VectorXd(), &robin);
+}
+
+FluidLoads NavierStokesFluid::solve(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                                    const Eigen::VectorXd& interface_velocity, const RobinCondition* robin) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto where = [&](const std::exception& e) {
     return fmt::format("step {} (t = {:.6g}, coupling iteration {}): {}", info.step, info.time, info.iteration,
@@ -1002,7 +1014,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
   }
   try {
     try {
-      solve_on_mesh(info, interface_displacement, interface_velocity);
+      solve_on_mesh(info, interface_displacement, interface_velocity, robin);
     } catch (const MeshTangled& e) {
       // The step's motion folded an element of a mesh that was valid at the step's start (the
       // quality check between steps came too late: one step moved the interface that far).
@@ -1017,7 +1029,7 @@ FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::Vect
         throw SolverError(fmt::format("{}; remeshing the step-start mesh failed: {}", e.what(), r.what()));
       }
       ++remesh_retries_;
-      solve_on_mesh(info, interface_displacement, interface_velocity);
+      solve_on_mesh(info, interface_displacement, interface_velocity, robin);
     }
   } catch (const SolverError& e) {
     throw SolverError(where(e));

@@ -183,6 +183,15 @@ class BasicFlowSolver {
   // (every node, current configuration), with the interface velocity per interface node
   // (interleaved, 2 * interface_nodes().size(); empty = zero). Repeatable before accept().
   StepReport solve(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
+  // The time level with a Robin condition on the interface instead of Nitsche's terms
+  // (the explicit Robin-Neumann coupling; RobinCondition, solver_model.hpp): at every
+  // interface node j, lumped,
+  //   f_sigma_j + A_j v_j = A_j v*_j + f*_j,   A_j = coefficient_j int_Gamma N_j
+  // (int N_j: the row sum of interface_mass() on the current interface), added to the node's
+  // momentum rows; no consistency, symmetry or penalty terms. f_sigma is then the reaction
+  // alone (interface_traction()). Nodes with a strong condition keep it. 2D only: on 6-node
+  // faces (3D) int N_j of a vertex is 0.
+  StepReport solve_robin(double time, double dt, const Nodes& positions, const RobinCondition& robin);
   void accept();
 
   // --- checkpoints (after accept()) ---
@@ -233,7 +242,8 @@ class BasicFlowSolver {
   // vertices a, b, c as in the mesh's boundary group, then the midpoints of ab, bc, ca).
   const std::vector<std::array<int, 6>>& interface_faces() const { return interface_faces_; }
   // f_sigma = int N^T sigma n (n = fluid outward normal), the reaction plus the penalty term
-  // gamma_N1 int N^T (v_f - v_s); f_v = int N^T v_f at the interface nodes (current configuration).
+  // gamma_N1 int N^T (v_f - v_s) (after a Robin solve the reaction alone); f_v = int N^T v_f
+  // at the interface nodes (current configuration).
   Eigen::VectorXd interface_traction() const;
   Eigen::VectorXd interface_velocity_integral() const;
   // M_f = int N_i N_j dgamma over the interface in the configuration of the last solve, with
@@ -257,9 +267,11 @@ class BasicFlowSolver {
   std::vector<int> interface_nodes_;
   IndexMatrix2 interface_segments_;
   std::vector<std::array<int, 6>> interface_faces_;
-  Eigen::VectorXd interface_velocity_;  // of the last solve
+  Eigen::VectorXd interface_velocity_;  // of the last solve (a Robin solve: v*)
+  bool robin_ = false;                  // the last solve had a Robin interface condition
   std::function<void(int, double)> observer_;
   Step begin_step(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
+  StepReport solve(Step& step);
   void assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report);
   bool locate(const PointD& point, int& element, Eigen::Matrix<double, Dim + 1, 1>& bary) const;
 };

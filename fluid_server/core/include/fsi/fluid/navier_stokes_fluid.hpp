@@ -47,6 +47,11 @@ class NavierStokesFluid : public FluidModel {
                            const Eigen::VectorXd& interface_velocity) override;
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                         const Eigen::VectorXd& interface_velocity) override;
+  // The explicit Robin-Neumann coupling's interface condition (FlowSolver::solve with a
+  // RobinCondition; 2D, both elements).
+  bool supports_robin() const override { return solver_ != nullptr; }
+  FluidLoads solve_robin(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                         const RobinCondition& robin) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
 
@@ -162,7 +167,10 @@ class NavierStokesFluid : public FluidModel {
   int retried_step_ = -1;                            // the step whose folding motion was remeshed and solved again
   int remesh_retries_ = 0;                           // how many steps were (a count, also in checkpoints)
   void solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
-                     const Eigen::VectorXd& interface_velocity);
+                     const Eigen::VectorXd& interface_velocity, const RobinCondition* robin);
+  // solve_step and solve_robin (robin: null = Nitsche's terms with interface_velocity).
+  FluidLoads solve(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
+                   const Eigen::VectorXd& interface_velocity, const RobinCondition* robin);
 };
 
 }  // namespace fsi::fluid
