@@ -34,7 +34,7 @@ STATE_FORMAT = "<8s4d"
 class SdofSolid(fs.Solid):
     name = "python sdof_solid.py"
     KEYS = {"model", "mass", "damping", "stiffness", "force", "interface_measure",
-            "initial_displacement", "initial_velocity", "dimension", "surface"}
+            "initial_displacement", "initial_velocity", "dimension", "surface", "substeps"}
 
     def configure(self, section, dt, end_time, interface_damping, output_dir):
         path = self.scene_path
@@ -43,6 +43,12 @@ class SdofSolid(fs.Solid):
         unknown = sorted(set(section) - self.KEYS)
         if unknown:
             raise InvalidArgument(f"{path}: unknown key(s) in solid section: {', '.join(unknown)}")
+        # Waveform iterations: this example takes one step per coupling window (it does not
+        # declare ConfigureReply.supports_substeps), so only `substeps: 1` is accepted.
+        if section.get("substeps", 1) != 1:
+            raise InvalidArgument(f"{path}: 'solid.substeps: {section['substeps']}' needs a solid that takes "
+                                  "substeps (waveform iterations); this one takes one step per window "
+                                  "(set solid.substeps: 1)")
 
         def number(key, default=None):
             value = section.get(key, default)

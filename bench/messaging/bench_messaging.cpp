@@ -66,7 +66,7 @@ class EchoSolid : public fsi::SolidModel {
   }
   fsi::InterfaceMeshData interface() const override { return line_interface(n_); }
   fsi::SolidStepResult solve_step(const fsi::StepInfo& info, const Eigen::VectorXd& f) override {
-    return {1e-3 * f, (1e-3 / info.dt) * f, 1};
+    return {1e-3 * f, (1e-3 / info.dt) * f, 1, {}, {}};
   }
   std::map<std::string, double> accept_step(const fsi::StepInfo&) override { return {}; }
 
@@ -82,9 +82,11 @@ class EchoFluid : public fsi::FluidModel {
     if (n_ < 1) s.fail("nodes", "must be >= 1");
   }
   fsi::InterfaceMeshData interface() const override { return line_interface(n_); }
-  fsi::FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override { return {-d, v, 1, {}}; }
+  fsi::FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override {
+    return {-d, v, 1, {}, {}, {}};
+  }
   fsi::FluidLoads solve_step(const fsi::StepInfo&, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override {
-    return {-1e3 * d, v, 1, {}};  // traction = -force on the solid: the loop stays bounded
+    return {-1e3 * d, v, 1, {}, {}, {}};  // traction = -force on the solid: the loop stays bounded
   }
   std::map<std::string, double> accept_step(const fsi::StepInfo&) override { return {}; }
 

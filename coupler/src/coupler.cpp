@@ -131,6 +131,82 @@ Eigen::VectorXd Coupler::traction_mismatch(Iterate& it, const Eigen::VectorXd& f
   return mismatch;
 }
 
+SolidStepResult Coupler::solve_solid(const Run& r, const Step& step, const StepInfo& info,
+                                     const Eigen::VectorXd& force) {
+  if (r.n_solid == 1) return solid_.solve_step(info, end_of(force, r.nv));
+  // The force's waveform: the accepted F_n at the window's start, then the fluid's samples.
+  Waveform w = Waveform::window(step.t_np1 - r.time.dt, r.time.dt, end_of(r.state.force_n, r.nv), force, r.n_fluid);
+  // and, once known, the previous window's end (F_{n-1}), for a second-order solid's
+  // higher-degree interpolation near the window's start.
+  if (r.state.forces_known >= 2) {
+    w.times.insert(w.times.begin(), step.t_np1 - 2 * r.time.dt);
+    w.values.insert(w.values.begin(), end_of(r.state.force_nm1, r.nv));
+  }
+  SolidStepResult s = solid_.solve_window(info, w, r.n_solid);
+  const Eigen::Index m = r.nv * r.n_solid;
+  if (s.displacement_samples.size() != m || s.velocity_samples.size() != m)
+    throw Stop{"failed", fmt::format("solid '{}' returned {} interface samples of its {} substeps, expected {}",
+                                     solid_.name(), s.displacement_samples.size(), r.n_solid, m)};
+  return s;
+}
+
+FluidLoads Coupler::solve_fluid(const Run& r, const Step& step, const StepInfo& info, const Eigen::VectorXd& d,
+                                const Eigen::VectorXd& v, Eigen::VectorXd& d_f) {
+  d_f = map_.to_fluid(end_of(d, r.nv));
+  if (r.n_fluid == 1) return fluid_.solve_step(info, d_f, map_.to_fluid(end_of(v, r.nv)));
+  // The interface state's waveforms on the fluid's nodes: the accepted state at the window's
+  // start, then the solid-side samples mapped.
+  const Eigen::Index nv = r.nv;
+  const Eigen::VectorXd start_d = r.state.d_f_prev, start_v = map_.to_fluid(r.state.v_s_prev);
+  const Eigen::Index mf = start_d.size();
+  Eigen::VectorXd fd(mf * r.n_solid), fv(mf * r.n_solid);
+  for (int j = 0; j < r.n_solid; ++j) {
+    fd.segment(j * mf, mf) = map_.to_fluid(d.segment(j * nv, nv));
+    fv.segment(j * mf, mf) = map_.to_fluid(v.segment(j * nv, nv));
+  }
+  const double start = step.t_np1 - r.time.dt;
+  FluidLoads loads = fluid_.solve_window(info, Waveform::window(start, r.time.dt, start_d, fd, r.n_solid),
+                                         Waveform::window(start, r.time.dt, start_v, fv, r.n_solid), r.n_fluid);
+  const Eigen::Index m = mf * r.n_fluid;
+  if (loads.traction_samples.size() != m || loads.velocity_integral_samples.size() != m)
+    throw Stop{"failed", fmt::format("fluid '{}' returned {} interface samples of its {} substeps, expected {}",
+                                     fluid_.name(), loads.traction_samples.size(), r.n_fluid, m)};
+  return loads;
+}
+
+void Coupler::window_force(const Run& r, const Step& step, Iterate& it, const Eigen::VectorXd& d,
+                           const Eigen::VectorXd& v, Eigen::VectorXd& f_star, Eigen::VectorXd& mismatch) const {
+  if (r.n_solid == 1 && r.n_fluid == 1) {
+    const Eigen::VectorXd fs = map_.to_solid(it.loads.traction_force), fv = map_.to_solid(it.loads.velocity_integral);
+    f_star = robin_force(fs, fv, v, d, it.mass);
+    mismatch = traction_mismatch(it, fs, fv, d, v, step.force);
+    return;
+  }
+  const Eigen::Index nv = r.nv;
+  const double start = step.t_np1 - r.time.dt;
+  const Waveform wd = Waveform::window(start, r.time.dt, r.state.d_s_prev, d, r.n_solid);
+  const Waveform wv = Waveform::window(start, r.time.dt, r.state.v_s_prev, v, r.n_solid);
+  const Waveform ws = Waveform::window(start, r.time.dt, r.state.v_s_prev, velocity_samples(it.s), r.n_solid);
+  const Eigen::VectorXd& traction = r.n_fluid == 1 ? it.loads.traction_force : it.loads.traction_samples;
+  const Eigen::VectorXd& integral = r.n_fluid == 1 ? it.loads.velocity_integral : it.loads.velocity_integral_samples;
+  const Eigen::Index mf = traction.size() / r.n_fluid;
+  f_star.resize(nv * r.n_fluid);
+  mismatch.resize(nv * r.n_fluid);
+  for (int j = 0; j < r.n_fluid; ++j) {
+    const double t = substep_time(start, r.time.dt, j + 1, r.n_fluid);
+    const Eigen::VectorXd fs = map_.to_solid(traction.segment(j * mf, mf)),
+                          fv = map_.to_solid(integral.segment(j * mf, mf));
+    const Eigen::VectorXd dj = wd.at(t), vj = wv.at(t);
+    Iterate sample;
+    sample.mass = it.mass;
+    sample.damping = it.damping;
+    sample.s.interface_velocity = ws.at(t);
+    f_star.segment(j * nv, nv) = robin_force(fs, fv, vj, dj, it.mass);
+    mismatch.segment(j * nv, nv) = traction_mismatch(sample, fs, fv, dj, vj, step.force.segment(j * nv, nv));
+    if (j + 1 == r.n_fluid) it.traction = sample.traction;
+  }
+}
+
 std::unique_ptr<Coupler::Scheme> Coupler::make_scheme() {
   if (settings_.scheme == CouplingScheme::Parallel) return std::make_unique<ParallelScheme>(*this);
   if (settings_.scheme == CouplingScheme::RobinNeumann) return std::make_unique<RobinNeumannScheme>(*this);
@@ -148,8 +224,8 @@ Coupler::Step Coupler::begin_step(Run& r, int n) {
   step.first_r.assign(n_measures, 0.0);
   step.values.assign(n_measures, 0.0);
   r.accelerator->begin_step();
-  step.d_iter_prev = st.d_s_prev;
-  step.v_iter_prev = st.v_s_prev;
+  step.d_iter_prev = repeated(st.d_s_prev, r.n_solid);
+  step.v_iter_prev = repeated(st.v_s_prev, r.n_solid);
   r.scheme->begin_step(r, step);
   return step;
 }
@@ -176,14 +252,15 @@ void Coupler::measure(Step& step, Update& u, const Eigen::VectorXd& traction_cha
   u.norm = u.relaxed.norm();
   u.change = (u.relaxed - step.force).norm();
   step.residual = u.change / std::max(u.norm, settings_.residual_floor);
-  const double r_quantity[4] = {u.change, traction_change.norm(), (s.interface_displacement - step.d_iter_prev).norm(),
-                                (s.interface_velocity - step.v_iter_prev).norm()};
-  const double q_quantity[4] = {u.norm, u.iterate.traction.norm(), s.interface_displacement.norm(),
-                                s.interface_velocity.norm()};
+  // Over the window: the solid's samples (its one step's state without substeps).
+  const Eigen::VectorXd &d = displacement_samples(s), &v = velocity_samples(s);
+  const double r_quantity[4] = {u.change, traction_change.norm(), (d - step.d_iter_prev).norm(),
+                                (v - step.v_iter_prev).norm()};
+  const double q_quantity[4] = {u.norm, u.iterate.traction.norm(), d.norm(), v.norm()};
   std::copy(r_quantity, r_quantity + 4, u.r_quantity);
   std::copy(q_quantity, q_quantity + 4, u.q_quantity);
-  step.d_iter_prev = s.interface_displacement;
-  step.v_iter_prev = s.interface_velocity;
+  step.d_iter_prev = d;
+  step.v_iter_prev = v;
 }
 
 bool Coupler::measures_met(Step& step, const Update& u) const {
@@ -330,11 +407,12 @@ void Coupler::accept_step(Run& r, Step& step) {
   r.timing.row(std::vector<double>{double(n), t_np1, r.wall_before + (now() - r.segment_start), times_.fluid,
                                    times_.solid, double(used)});
   if (r.time.output_every > 0 && n % r.time.output_every == 0)
-    write_output(r, accepted,
-                 InterfaceFields{last.s.interface_displacement, last.s.interface_velocity, last.force_applied,
-                                 map_.to_solid(last.loads.traction_force), map_.to_solid(last.loads.velocity_integral),
-                                 last.d_f, map_.to_fluid(last.s.interface_velocity), last.loads.traction_force,
-                                 last.loads.velocity_integral});
+    write_output(
+        r, accepted,
+        InterfaceFields{last.s.interface_displacement, last.s.interface_velocity, end_of(last.force_applied, r.nv),
+                        map_.to_solid(last.loads.traction_force), map_.to_solid(last.loads.velocity_integral), last.d_f,
+                        map_.to_fluid(last.s.interface_velocity), last.loads.traction_force,
+                        last.loads.velocity_integral});
   r.accelerator->end_step();
   r.state.accept_force(step.force);
   r.growth.add(last.s.interface_displacement.lpNorm<Eigen::Infinity>(), n, settings_.growth_factor,
@@ -353,7 +431,8 @@ void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::strin
   State& st = r.state;
   const double gamma = r.gamma_n1;
   const SolidStepResult& s = last.s;
-  st.work_solid += last.force_applied.dot(s.interface_displacement - st.d_s_prev);
+  const Eigen::VectorXd applied = end_of(last.force_applied, r.nv);  // at the window's end
+  st.work_solid += applied.dot(s.interface_displacement - st.d_s_prev);
   st.work_fluid -= last.loads.traction_force.dot(last.d_f - st.d_f_prev);
   // The same work evaluated on the solid's nodes through the transpose mapping:
   // identical up to round-off (the mapping neither creates nor destroys energy).
@@ -365,7 +444,7 @@ void Coupler::interface_balance(Run& r, const Iterate& last, std::map<std::strin
   // when the solid's operator is the fluid's, robin_mass: consistent).
   const Eigen::VectorXd dd = s.interface_displacement - st.d_s_prev;
   const Eigen::VectorXd& v = s.interface_velocity;
-  Eigen::VectorXd load = last.force_applied;
+  Eigen::VectorXd load = applied;
   if (last.damping.rows() > 0) load -= gamma * apply_nodal(last.damping, v);
   double uncancelled = 0;
   const double g = r.implicit ? gamma : settings_.gamma_f;  // the parameter of C's term

@@ -145,12 +145,13 @@ void Coupler::State::save(StateArchive& c) const {
 }
 
 // The coupler's own entries of a checkpoint (the accelerator's and the scheme's are theirs).
-bool Coupler::State::load(const StateArchive& c, Eigen::Index nv, Eigen::Index ns, const std::string& dir) {
-  force_n = c.vector("force_n", nv);
-  force_nm1 = c.vector("force_nm1", nv);
+bool Coupler::State::load(const StateArchive& c, Eigen::Index nv, Eigen::Index nf, Eigen::Index ns,
+                          const std::string& dir) {
+  force_n = c.vector("force_n", nf);
+  force_nm1 = c.vector("force_nm1", nf);
   // Before the predictors' longer history: F_n and F_{n-1}.
-  force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", nv) : force_nm1;
-  force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", nv) : force_nm2;
+  force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", nf) : force_nm1;
+  force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", nf) : force_nm2;
   forces_known = c.has("forces_known") ? static_cast<int>(c.integer("forces_known")) : 2;
   d_s_prev = c.vector("d_s_prev", nv);
   d_f_prev = c.vector("d_f_prev", d_f_prev.size());
@@ -182,7 +183,7 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   State& st = r.state;
   const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
   const std::string dir = r.restart->dir.string();
-  if (!st.load(c, r.nv, ns, dir) && r.implicit && r.gamma_n1 > 0)
+  if (!st.load(c, r.nv, r.nv * r.n_fluid, ns, dir) && r.implicit && r.gamma_n1 > 0)
     r.log->warn(
         "checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
         "solid's own int N^T N",
@@ -216,10 +217,12 @@ void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {
         "keeps the old algorithm's force",
         r.restart->dir.string());
   else {
-    for (Eigen::VectorXd* f : {&st.force_n, &st.force_nm1, &st.force_nm2, &st.force_nm3}) {
-      if (old_algorithm == 2 && old_gamma > 0) *f -= old_gamma * apply_nodal(c_mass, st.v_s_prev);
-      if (r.implicit && gamma > 0) *f += gamma * apply_nodal(c_mass, st.v_s_prev);
-    }
+    for (Eigen::VectorXd* f : {&st.force_n, &st.force_nm1, &st.force_nm2, &st.force_nm3})
+      for (int j = 0; j < r.n_fluid; ++j) {  // every sample of the waveform
+        auto block = f->segment(j * r.nv, r.nv);
+        if (old_algorithm == 2 && old_gamma > 0) block -= old_gamma * apply_nodal(c_mass, st.v_s_prev);
+        if (r.implicit && gamma > 0) block += gamma * apply_nodal(c_mass, st.v_s_prev);
+      }
     r.data["forked_from"]["predictor_converted"] = true;
   }
   r.accelerator = make_accelerator(settings_);
@@ -242,13 +245,14 @@ void Coupler::initial_state(Run& r) {
   st.mapped_mass = map_mass(r, loads);
   st.force_n = -robin_force(map_.to_solid(loads.traction_force), map_.to_solid(loads.velocity_integral), v_s, d_s,
                             st.mapped_mass);
-  st.force_nm1 = st.force_nm2 = st.force_nm3 = st.force_n;
   if (r.time.output_every > 0) {  // the initial state, t = 0
     write_output(r, StepInfo{0.0, r.time.dt, 0, 0},
                  InterfaceFields{d_s, v_s, st.force_n, map_.to_solid(loads.traction_force),
                                  map_.to_solid(loads.velocity_integral), map_.to_fluid(d_s), map_.to_fluid(v_s),
                                  loads.traction_force, loads.velocity_integral});
   }
+  st.force_n = repeated(st.force_n, r.n_fluid);  // a waveform: constant over the fluid's substeps
+  st.force_nm1 = st.force_nm2 = st.force_nm3 = st.force_n;
 }
 
 void Coupler::open_tables(Run& r) {

@@ -46,6 +46,25 @@ class Timer {
 
 inline bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
 
+// Waveforms: `count` copies of v, concatenated (v itself for one).
+inline Eigen::VectorXd repeated(const Eigen::VectorXd& v, int count) {
+  if (count == 1) return v;
+  Eigen::VectorXd out(v.size() * count);
+  for (int j = 0; j < count; ++j) out.segment(j * v.size(), v.size()) = v;
+  return out;
+}
+// The last of a waveform's samples of m values each: the window's end.
+inline Eigen::VectorXd end_of(const Eigen::VectorXd& samples, Eigen::Index m) {
+  return samples.size() == m ? samples : Eigen::VectorXd(samples.tail(m));
+}
+// The solid's interface state over the window: its samples, or its one step's.
+inline const Eigen::VectorXd& displacement_samples(const SolidStepResult& s) {
+  return s.displacement_samples.size() > 0 ? s.displacement_samples : s.interface_displacement;
+}
+inline const Eigen::VectorXd& velocity_samples(const SolidStepResult& s) {
+  return s.velocity_samples.size() > 0 ? s.velocity_samples : s.interface_velocity;
+}
+
 // A run-time stop with its classification.
 struct Stop {
   std::string status, reason;
@@ -114,7 +133,8 @@ struct Coupler::State {
   // (nv values per vector, ns nodes of mapped_mass) and says whether mapped_mass was there
   // (checkpoints of earlier versions hold none).
   void save(StateArchive& c) const;
-  bool load(const StateArchive& c, Eigen::Index nv, Eigen::Index ns, const std::string& dir);
+  // (nf values per force: F is the fluid's samples over the window).
+  bool load(const StateArchive& c, Eigen::Index nv, Eigen::Index nf, Eigen::Index ns, const std::string& dir);
 };
 
 // One coupling iteration's solves; the step accepts its last one.
@@ -174,6 +194,8 @@ struct Coupler::Run {
         ns(static_cast<Eigen::Index>(c.solid_interface_.nodes())),
         dim(c.solid_interface_.dimension),
         nv(static_cast<Eigen::Index>(c.solid_interface_.values())),
+        n_solid(c.solid_substeps_),
+        n_fluid(c.fluid_substeps_),
         vtk_dir(c.out_dir_ / "vtk"),
         checkpoints(time.checkpoint_every > 0),
         start(start_time),
@@ -200,6 +222,10 @@ struct Coupler::Run {
   const Eigen::Index ns;  // solid interface nodes
   const int dim;          // values per interface node (2 or 3)
   const Eigen::Index nv;  // values of a solid interface vector, dim * ns
+  // Waveform iterations: the solid's and the fluid's substeps in a window (time.dt). F^(k) is
+  // the fluid's samples (n_fluid x nv values), the solid's interface state its samples
+  // (n_solid x nv); one each = a step without waveforms.
+  const int n_solid, n_fluid;
   const std::filesystem::path vtk_dir;
   const bool checkpoints;
   const double start;  // wall clock at run()'s start

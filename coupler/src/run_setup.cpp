@@ -64,6 +64,22 @@ TimeSettings Coupler::configure(InterfaceMeshData& fluid_interface) {
   }
   solid_interface_ = solid_.interface();
   fluid_interface = fluid_.interface();
+  // Waveform iterations: each solver's substeps in a window, from its own section.
+  solid_substeps_ = substeps_of(scene_.section("solid"));
+  fluid_substeps_ = substeps_of(scene_.section("fluid"));
+  const auto refuse_substeps = [&](const char* section, int n, bool supported, const std::string& name) {
+    if (n > 1 && !supported)
+      throw Stop{"failed", fmt::format("{}.substeps: {} needs a {} that takes substeps (waveform iterations), which "
+                                       "{} '{}' does not (ConfigureReply.supports_substeps); set {}.substeps: 1",
+                                       section, n, section, section, name, section)};
+    if (n > 1 && settings_.scheme == CouplingScheme::RobinNeumann)
+      throw Stop{"failed", fmt::format("{}.substeps: {} with coupling.scheme robin-neumann: the explicit scheme "
+                                       "takes one step per window (waveform iterations need scheme serial or "
+                                       "parallel)",
+                                       section, n)};
+  };
+  refuse_substeps("solid", solid_substeps_, solid_.supports_substeps(), solid_.name());
+  refuse_substeps("fluid", fluid_substeps_, fluid_.supports_substeps(), fluid_.name());
   {
     Timer t(times_.coupler);
     try {

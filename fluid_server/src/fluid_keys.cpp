@@ -1,5 +1,6 @@
 // The `fluid` section: one table of keys per model this server hosts, each declared beside
 // its model's reader (surrogate_keys.cpp, core/src/navier_stokes_keys.cpp).
+#include "fsi/common/waveform.hpp"
 #include "fsi/models/fluid_factory.hpp"
 #include "fsi/models/surrogate_fluid.hpp"
 #ifdef FSI_HAVE_FEM_FLUID
@@ -16,6 +17,9 @@ const schema::Key& fluid_section() {
     models.push_back({"fem", "incompressible Navier-Stokes on a moving (ALE) mesh, P1/P1 or P2/P1",
                       fsi::fluid::navier_stokes_keys()});
 #endif
+    // Every model takes `substeps` (waveform iterations; the coupler reads it).
+    for (auto& model : models)
+      for (auto& key : window_keys()) model.keys.push_back(std::move(key));
     schema::Key k = schema::selector_section("fluid", "the fluid solver (fluid_server)", "model", std::move(models));
     schema::declare(k);
     return k;

@@ -44,6 +44,25 @@ FluidLoads SurrogateFluid::solve_step(const StepInfo& info, const Eigen::VectorX
   return loads(v_, (v_ - v_n_) / info.dt);
 }
 
+FluidLoads SurrogateFluid::solve_window(const StepInfo& info, const Waveform&, const Waveform& v, int substeps) {
+  const double h = info.dt / substeps, start = info.time - info.dt;
+  const Eigen::Index m = v_n_.size();
+  Eigen::VectorXd traction(m * substeps), velocity_integral(m * substeps);
+  Eigen::VectorXd v_prev = v_n_;
+  FluidLoads out;
+  for (int j = 1; j <= substeps; ++j) {
+    v_ = v.at(substep_time(start, info.dt, j, substeps));
+    out = loads(v_, (v_ - v_prev) / h);
+    traction.segment((j - 1) * m, m) = out.traction_force;
+    velocity_integral.segment((j - 1) * m, m) = out.velocity_integral;
+    v_prev = v_;
+  }
+  out.traction_samples = traction;
+  out.velocity_integral_samples = velocity_integral;
+  out.nonlinear_iterations = substeps;
+  return out;
+}
+
 FluidLoads SurrogateFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd&, const RobinCondition& robin) {
   const Eigen::Index d = interface_.dimension();
   const auto& lumped = interface_.mesh.lumped_measure;

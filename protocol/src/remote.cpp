@@ -245,6 +245,21 @@ fsi::v1::SolveStep* step_request(fsi::v1::Request& r, const StepInfo& info) {
   return s;
 }
 
+// A SolveStep's waveform (waveform iterations): the substeps, the sample times and the
+// samples' vectors concatenated into `field`.
+void window_request(fsi::v1::SolveStep* s, const Waveform& w, int substeps,
+                    google::protobuf::RepeatedField<double>* field) {
+  s->set_substeps(static_cast<unsigned>(substeps));
+  for (std::size_t i = 0; i < w.times.size(); ++i) {
+    s->add_sample_times(w.times[i]);
+    for (Eigen::Index j = 0; j < w.values[i].size(); ++j) field->Add(w.values[i][j]);
+  }
+}
+
+// `count` vectors of the interface's values, concatenated, checked as checked() does.
+Eigen::VectorXd checked_samples(const google::protobuf::RepeatedField<double>& f, const InterfaceMeshData& mesh,
+                                int count, const ProtocolClient& client, const char* what);
+
 // A solver failure on the server side is a SolverError on this side (the run diverged),
 // any other error reply stays a RemoteError (the run failed).
 fsi::v1::Reply step_call(ProtocolClient& client, const fsi::v1::Request& r) {
@@ -294,6 +309,18 @@ Eigen::VectorXd checked(const google::protobuf::RepeatedField<double>& f, const 
     if (!std::isfinite(v[i]))
       throw SolverError(
           fmt::format("{} sent a non-finite '{}' at node {}", client.peer_name(), what, i / mesh.dimension));
+  return v;
+}
+
+Eigen::VectorXd checked_samples(const google::protobuf::RepeatedField<double>& f, const InterfaceMeshData& mesh,
+                                int count, const ProtocolClient& client, const char* what) {
+  const std::size_t expected = mesh.values() * static_cast<std::size_t>(count);
+  if (static_cast<std::size_t>(f.size()) != expected)
+    throw RemoteError(fsi::v1::Error::INVALID_ARGUMENT,
+                      fmt::format("{} sent {} values for '{}', expected {} ({} substeps x {} nodes x {})",
+                                  client.peer_name(), f.size(), what, expected, count, mesh.nodes(), mesh.dimension));
+  Eigen::VectorXd v = to_eigen(f);
+  if (!v.allFinite()) throw SolverError(fmt::format("{} sent a non-finite '{}'", client.peer_name(), what));
   return v;
 }
 
@@ -378,6 +405,26 @@ void RemoteSolid::configure(const ConfigSection& section, const SolidSetup& setu
   const auto configured = client_->call(r);
   expect(configured.has_configure(), *client_, "configure");
   interface_ = get_interface(*client_, configured.configure().interface_nodes());
+  supports_substeps_ = configured.configure().supports_substeps();
+}
+
+SolidStepResult RemoteSolid::solve_window(const StepInfo& info, const Waveform& force, int substeps) {
+  fsi::v1::Request r;
+  auto* s = step_request(r, info);
+  window_request(s, force, substeps, s->mutable_interface_force());
+  if (send_interface_mass_) nodal_to_proto(interface_mass_, s->mutable_interface_mass());
+  const auto reply = step_call(*client_, r);
+  send_interface_mass_ = false;
+  expect(reply.has_solid_step(), *client_, "solve_step");
+  const auto& step = reply.solid_step();
+  SolidStepResult out;
+  out.interface_displacement = checked(step.interface_displacement(), interface_, *client_, "interface_displacement");
+  out.interface_velocity = checked(step.interface_velocity(), interface_, *client_, "interface_velocity");
+  out.displacement_samples =
+      checked_samples(step.displacement_samples(), interface_, substeps, *client_, "displacement_samples");
+  out.velocity_samples = checked_samples(step.velocity_samples(), interface_, substeps, *client_, "velocity_samples");
+  out.newton_iterations = static_cast<int>(step.newton_iterations());
+  return out;
 }
 
 SolidStepResult RemoteSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& force) {
@@ -422,6 +469,7 @@ void RemoteFluid::configure(const ConfigSection& section, const FluidSetup& setu
   expect(configured.has_configure(), *client_, "configure");
   interface_ = get_interface(*client_, configured.configure().interface_nodes());
   supports_robin_ = configured.configure().supports_robin();
+  supports_substeps_ = configured.configure().supports_substeps();
 }
 
 namespace {
@@ -456,6 +504,21 @@ FluidLoads RemoteFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& 
   from_eigen(d, s->mutable_interface_displacement());
   from_eigen(v, s->mutable_interface_velocity());
   return loads_from(step_call(*client_, r), interface_, *client_);
+}
+
+FluidLoads RemoteFluid::solve_window(const StepInfo& info, const Waveform& d, const Waveform& v, int substeps) {
+  fsi::v1::Request r;
+  auto* s = step_request(r, info);
+  window_request(s, d, substeps, s->mutable_interface_displacement());
+  for (const auto& value : v.values)
+    for (Eigen::Index j = 0; j < value.size(); ++j) s->add_interface_velocity(value[j]);
+  const auto reply = step_call(*client_, r);
+  FluidLoads out = loads_from(reply, interface_, *client_);
+  out.traction_samples =
+      checked_samples(reply.fluid_loads().traction_samples(), interface_, substeps, *client_, "traction_samples");
+  out.velocity_integral_samples = checked_samples(reply.fluid_loads().velocity_integral_samples(), interface_, substeps,
+                                                  *client_, "velocity_integral_samples");
+  return out;
 }
 
 FluidLoads RemoteFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd& d, const RobinCondition& robin) {

@@ -106,6 +106,43 @@ StepInfo checked_step(const fsi::v1::SolveStep& s) {
   return {s.time(), s.dt(), static_cast<int>(s.step()), static_cast<int>(s.iteration())};
 }
 
+// A SolveStep's waveform (SolveStep.substeps > 1): sample_times, increasing, from the window's
+// start to `time`, and one interface vector per sample in `field`.
+Waveform checked_waveform(const fsi::v1::SolveStep& s, const google::protobuf::RepeatedField<double>& field,
+                          std::size_t nodes, int dim, const char* name) {
+  const int count = s.sample_times_size();
+  if (count < 2)
+    throw std::invalid_argument(
+        fmt::format("solve_step: substeps {} needs sample_times (at least the window's start "
+                    "and end), got {}",
+                    s.substeps(), count));
+  Waveform w;
+  for (int i = 0; i < count; ++i) {
+    if (!std::isfinite(s.sample_times(i)) || (i > 0 && !(s.sample_times(i) > s.sample_times(i - 1))))
+      throw std::invalid_argument("solve_step: sample_times must be finite and increasing");
+    w.times.push_back(s.sample_times(i));
+  }
+  const std::size_t m = nodes * static_cast<std::size_t>(dim);
+  if (static_cast<std::size_t>(field.size()) != m * static_cast<std::size_t>(count))
+    throw std::invalid_argument(fmt::format("'{}' has {} values, expected {} ({} samples x {} per sample)", name,
+                                            field.size(), m * count, count, m));
+  const Eigen::VectorXd all = to_eigen(field);
+  if (!all.allFinite()) throw std::invalid_argument(fmt::format("'{}' has a value that is not finite", name));
+  for (int i = 0; i < count; ++i) w.values.push_back(all.segment(static_cast<Eigen::Index>(i * m), m));
+  return w;
+}
+
+// A solver section's substeps, read (so the key counts as used) and checked against the model.
+int configured_substeps(const ConfigSection& section, bool supported, const std::string& model) {
+  const int n = substeps_of(section);
+  if (n > 1 && !supported)
+    throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                      fmt::format("{}.substeps: {} needs a model that takes substeps (waveform iterations); '{}' "
+                                  "does not (set {}.substeps: 1)",
+                                  section.path(), n, model, section.path()));
+  return n;
+}
+
 void require_finite(const Eigen::VectorXd& v, int dim, const std::string& what) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))
@@ -299,29 +336,46 @@ void SolidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
                           fmt::format("solid model '{}' cannot add interface damping (Algorithm 2)", model->name()));
       SolidSetup setup{c.dt(), c.end_time(), c.interface_damping(), c.output_dir(), read_vtk_format(scene)};
       model->configure(section, setup);
+      configured_substeps(section, model->supports_substeps(), model->name());
       scene.check_all_used(section.path());
       model_ = std::move(model);
       interface_nodes_ = model_->interface().nodes();
       dimension_ = model_->interface().dimension;
       dt_ = c.dt();
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
+      reply.mutable_configure()->set_supports_substeps(model_->supports_substeps());
       break;
     }
     case R::kSolveStep: {
       need_model("solve_step");
       const auto& s = request.solve_step();
-      const Eigen::VectorXd force =
-          checked_vector(s.interface_force(), interface_nodes_, dimension_, "interface_force");
+      const bool window = s.substeps() > 1;
+      if (window && !model_->supports_substeps())
+        throw RemoteError(fsi::v1::Error::UNSUPPORTED,
+                          fmt::format("solid model '{}' does not take substeps (SolveStep.substeps)", model_->name()));
       const StepInfo info = checked_step(s);
+      const Eigen::VectorXd force =
+          window ? Eigen::VectorXd()
+                 : checked_vector(s.interface_force(), interface_nodes_, dimension_, "interface_force");
+      const Waveform force_samples =
+          window ? checked_waveform(s, s.interface_force(), interface_nodes_, dimension_, "interface_force")
+                 : Waveform();
       if (s.has_interface_mass())
         model_->set_interface_mass(nodal_from_proto(s.interface_mass(), interface_nodes_, "interface_mass"));
-      const SolidStepResult result = model_->solve_step(info, force);
+      const SolidStepResult result = window ? model_->solve_window(info, force_samples, static_cast<int>(s.substeps()))
+                                            : model_->solve_step(info, force);
       require_finite(result.interface_displacement, dimension_, "solid step (displacement)");
       require_finite(result.interface_velocity, dimension_, "solid step (velocity)");
       auto* out = reply.mutable_solid_step();
       from_eigen(result.interface_displacement, out->mutable_interface_displacement());
       from_eigen(result.interface_velocity, out->mutable_interface_velocity());
       out->set_newton_iterations(result.newton_iterations);
+      if (window) {
+        require_finite(result.displacement_samples, dimension_, "solid step (displacement samples)");
+        require_finite(result.velocity_samples, dimension_, "solid step (velocity samples)");
+        from_eigen(result.displacement_samples, out->mutable_displacement_samples());
+        from_eigen(result.velocity_samples, out->mutable_velocity_samples());
+      }
       break;
     }
     default:
@@ -348,6 +402,12 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
     from_eigen(loads.velocity_integral, out->mutable_velocity_integral());
     out->set_nonlinear_iterations(loads.nonlinear_iterations);
     if (loads.interface_mass.rows() > 0) nodal_to_proto(loads.interface_mass, out->mutable_interface_mass());
+    if (loads.traction_samples.size() > 0) {
+      require_finite(loads.traction_samples, dimension_, "fluid step (traction samples)");
+      require_finite(loads.velocity_integral_samples, dimension_, "fluid step (velocity integral samples)");
+      from_eigen(loads.traction_samples, out->mutable_traction_samples());
+      from_eigen(loads.velocity_integral_samples, out->mutable_velocity_integral_samples());
+    }
   };
   switch (request.body_case()) {
     case R::kHello: {
@@ -379,12 +439,14 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
       FluidSetup setup{c.dt(),         c.end_time(),          c.nitsche_penalty(), c.nitsche_symmetry(),
                        c.output_dir(), read_vtk_format(scene)};
       model->configure(section, setup);
+      configured_substeps(section, model->supports_substeps(), model->name());
       scene.check_all_used(section.path());
       model_ = std::move(model);
       interface_nodes_ = model_->interface().nodes();
       dimension_ = model_->interface().dimension;
       reply.mutable_configure()->set_interface_nodes(static_cast<unsigned>(interface_nodes_));
       reply.mutable_configure()->set_supports_robin(model_->supports_robin());
+      reply.mutable_configure()->set_supports_substeps(model_->supports_substeps());
       break;
     }
     case R::kInitialLoads: {
@@ -410,6 +472,23 @@ void FluidService::dispatch(const fsi::v1::Request& request, fsi::v1::Reply& rep
             RobinCondition{checked_vector(rc.coefficient(), interface_nodes_, 1, "robin.coefficient"),
                            checked_vector(rc.velocity(), interface_nodes_, dimension_, "robin.velocity"),
                            checked_vector(rc.traction(), interface_nodes_, dimension_, "robin.traction")}));
+        break;
+      }
+      if (s.substeps() > 1) {
+        if (!model_->supports_substeps())
+          throw RemoteError(
+              fsi::v1::Error::UNSUPPORTED,
+              fmt::format("fluid model '{}' does not take substeps (SolveStep.substeps)", model_->name()));
+        const Waveform d =
+            checked_waveform(s, s.interface_displacement(), interface_nodes_, dimension_, "interface_displacement");
+        const Waveform v =
+            checked_waveform(s, s.interface_velocity(), interface_nodes_, dimension_, "interface_velocity");
+        const FluidLoads loads = model_->solve_window(info, d, v, static_cast<int>(s.substeps()));
+        const auto m = static_cast<Eigen::Index>(interface_nodes_) * dimension_ * s.substeps();
+        if (loads.traction_samples.size() != m || loads.velocity_integral_samples.size() != m)
+          throw std::logic_error(
+              fmt::format("fluid model '{}' returned no samples of its {} substeps", model_->name(), s.substeps()));
+        loads_reply(loads);
         break;
       }
       loads_reply(model_->solve_step(

@@ -46,16 +46,41 @@ InterfaceMeshData SdofSolid::interface() const {
   return data;
 }
 
-SolidStepResult SdofSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) {
-  const double dt = info.dt;
+void SdofSolid::bdf1(double dt, const Eigen::VectorXd& interface_force, Eigen::VectorXd& d, Eigen::VectorXd& v) const {
   const double c = damping_ + interface_damping_;
-  // m (d - d_n - dt v_n)/dt^2 + c (d - d_n)/dt + k d = F
+  // m (d' - d - dt v)/dt^2 + c (d' - d)/dt + k d' = F
   const double lhs = mass_ / (dt * dt) + c / dt + stiffness_;
   const Eigen::VectorXd rhs =
-      interface_.resultant(interface_force) + force_ + mass_ * (d_n_ / (dt * dt) + v_n_ / dt) + c * d_n_ / dt;
-  d_ = rhs / lhs;
-  v_ = (d_ - d_n_) / dt;
-  return {interface_.uniform(d_), interface_.uniform(v_), 1};
+      interface_.resultant(interface_force) + force_ + mass_ * (d / (dt * dt) + v / dt) + c * d / dt;
+  const Eigen::VectorXd d_new = rhs / lhs;
+  v = (d_new - d) / dt;
+  d = d_new;
+}
+
+SolidStepResult SdofSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) {
+  d_ = d_n_;
+  v_ = v_n_;
+  bdf1(info.dt, interface_force, d_, v_);
+  return {interface_.uniform(d_), interface_.uniform(v_), 1, {}, {}};
+}
+
+SolidStepResult SdofSolid::solve_window(const StepInfo& info, const Waveform& force, int substeps) {
+  const double h = info.dt / substeps, start = info.time - info.dt;
+  d_ = d_n_;
+  v_ = v_n_;
+  SolidStepResult out;
+  const Eigen::Index m = static_cast<Eigen::Index>(interface_.mesh.values());
+  out.displacement_samples.resize(m * substeps);
+  out.velocity_samples.resize(m * substeps);
+  for (int j = 1; j <= substeps; ++j) {
+    bdf1(h, force.at(substep_time(start, info.dt, j, substeps)), d_, v_);
+    out.displacement_samples.segment((j - 1) * m, m) = interface_.uniform(d_);
+    out.velocity_samples.segment((j - 1) * m, m) = interface_.uniform(v_);
+  }
+  out.interface_displacement = interface_.uniform(d_);
+  out.interface_velocity = interface_.uniform(v_);
+  out.newton_iterations = substeps;
+  return out;
 }
 
 std::map<std::string, double> SdofSolid::accept_step(const StepInfo&) {

@@ -32,6 +32,8 @@ declaration_files = {
     "fluid_server/core/src/navier_stokes_keys.cpp": "fluid",
     # the point models' interface (dimension, surface), in both the solid and the fluid section
     "common/src/model_interface_keys.cpp": "interface",
+    # every solver section's `substeps` (waveform iterations), read by the coupler
+    "common/src/window_keys.cpp": "interface",
 }
 # The schema's own code (the builders, the checker, Scene's scene/description) may use both.
 schema_files = {"common/src/scene_declare.cpp", "common/src/scene_schema.cpp", "common/src/config.cpp",

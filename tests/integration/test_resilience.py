@@ -158,6 +158,10 @@ RESUME_CASES = {
     "added_mass_robin_neumann": ("added_mass.yaml", ["time.end=20", "time.checkpoint_every=100",
                                                      "coupling.scheme=robin-neumann", "coupling.robin_neumann_order=2",
                                                      "coupling.iterations={max: 1, tolerance: 0}"], 1250, 60),
+    # Waveform iterations: the solid in 2 substeps per window over the protocol's samples; the
+    # window-start force and the waveform-sized force history and secant pairs across the checkpoint.
+    "added_mass_waveform": ("added_mass.yaml", ["time.end=8", "time.checkpoint_every=100", "solid.substeps=2",
+                                                "coupling.acceleration=iqn-ils", "coupling.relaxation=0.5"], 550, 60),
     # Three dimensions: the plate interfaces (solid quadrilaterals, fluid triangles), 3 values
     # per node in every checkpointed vector, with added mass and IQN-ILS's secant pairs.
     "sdof_3d": ("sdof_3d.yaml", ["time.end=40", "time.checkpoint_every=100", "time.output_every=0",
@@ -225,6 +229,7 @@ def resume_small(env):
     resume_case(env, "added_mass_imvj_svd", "SIGINT")
     resume_case(env, "added_mass_parallel", "kill -9 coupler")
     resume_case(env, "added_mass_robin_neumann", "kill -9 coupler")
+    resume_case(env, "added_mass_waveform", "SIGINT")
     # The Python example solid in place of solid_server saves and loads its own state.
     solid = f"/usr/bin/python3 {env.source}/python/sdof_solid.py --proto-dir {env.proto}"
     RESUME_CASES["python_solid"] = RESUME_CASES["sdof_model"]

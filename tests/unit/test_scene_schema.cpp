@@ -69,6 +69,16 @@ TEST(SceneSchema, ProblemsNameKeyPlaceAndSuggestion) {
                                       "'fluid'"}));
 }
 
+// Waveform iterations: every solver section (whatever its model) takes `substeps`, >= 1.
+TEST(SceneSchema, SubstepsInEverySolverSectionAtLeastOne) {
+  EXPECT_TRUE(problems(kScene, {"solid.substeps=4", "fluid.substeps=2"}).empty());
+  EXPECT_EQ(problems(kScene, {"solid.substeps=0", "fluid.substeps=1.5"}),
+            (std::vector<std::string>{
+                "s.yaml (--set solid.substeps=0): 'solid.substeps' must be in [1, 1000], got '0'",
+                "s.yaml (--set fluid.substeps=1.5): 'fluid.substeps' must be an integer, got '1.5'",
+            }));
+}
+
 TEST(SceneSchema, IntegerListsNameTheBadEntryAndKeepTheirRange) {
   auto bad = [](const std::string& set) {
     std::vector<std::string> out;

@@ -15,8 +15,16 @@ std::vector<std::string> Coupler::ParallelScheme::columns() const { return {"int
 
 // The fluid's first interface state: the accepted one, its displacement extrapolated.
 void Coupler::ParallelScheme::begin_step(const Run& r, Step& step) const {
-  step.x_d = r.state.d_s_prev + r.time.dt * r.state.v_s_prev;
-  step.x_v = r.state.v_s_prev;
+  if (r.n_solid == 1) {
+    step.x_d = r.state.d_s_prev + r.time.dt * r.state.v_s_prev;
+    step.x_v = r.state.v_s_prev;
+    return;
+  }
+  // Waveforms: the same extrapolation at every substep's end.
+  step.x_d.resize(r.nv * r.n_solid);
+  for (int j = 1; j <= r.n_solid; ++j)
+    step.x_d.segment((j - 1) * r.nv, r.nv) = r.state.d_s_prev + (r.time.dt * j / r.n_solid) * r.state.v_s_prev;
+  step.x_v = repeated(r.state.v_s_prev, r.n_solid);
 }
 
 // The interface state must have converged too: its change below the measures' smallest limit.
@@ -48,38 +56,31 @@ Coupler::Update Coupler::ParallelScheme::iterate(Run& r, Step& step) {
   const StepInfo info{step.t_np1, r.time.dt, n, k};
   Update u = c.begin_iteration(r, step);
   Iterate& it = u.iterate;
-  Eigen::VectorXd v_f;
-  {
-    Timer t(c.times_.coupler);
-    it.d_f = c.map_.to_fluid(step.x_d);
-    v_f = c.map_.to_fluid(step.x_v);
-  }
   // Each server has its own connection: the solid's request goes from a second thread while
   // this one waits for the fluid; both wait for the other before anything is thrown.
   auto solid_job = std::async(std::launch::async, [&] {
     Timer t(c.times_.solid);
-    return c.solid_.solve_step(info, step.force);
+    return c.solve_solid(r, step, info, step.force);
   });
   try {
     Timer t(c.times_.fluid);
-    it.loads = c.fluid_.solve_step(info, it.d_f, v_f);
+    it.loads = c.solve_fluid(r, step, info, step.x_d, step.x_v, it.d_f);
   } catch (...) {
     solid_job.wait();
     throw;
   }
   it.s = solid_job.get();
   const SolidStepResult& s = it.s;
-  if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
+  if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity) ||
+      !all_finite(displacement_samples(s)) || !all_finite(velocity_samples(s)))
     throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
   Eigen::VectorXd traction_change;
   {
     Timer t(c.times_.coupler);
     it.mass = c.map_mass(r, it.loads);
-    const Eigen::VectorXd fs = c.map_.to_solid(it.loads.traction_force),
-                          fv = c.map_.to_solid(it.loads.velocity_integral);
     // F* of the interface state the fluid was given.
-    const Eigen::VectorXd f_star = c.robin_force(fs, fv, step.x_v, step.x_d, it.mass);
-    traction_change = c.traction_mismatch(it, fs, fv, step.x_d, step.x_v, step.force);
+    Eigen::VectorXd f_star;
+    c.window_force(r, step, it, step.x_d, step.x_v, f_star, traction_change);
     stacked_update(r, step, u, -f_star - step.force);
     r.state.mapped_mass = it.mass;
   }
@@ -108,17 +109,20 @@ constexpr double kScaleFloor = 1e-3;  // of a block's largest scale (stacked_upd
 
 void Coupler::ParallelScheme::stacked_update(Run& r, const Step& step, Update& u, const Eigen::VectorXd& r_force) {
   const SolidStepResult& s = u.iterate.s;
-  const Eigen::Index m = step.force.size();
   const Eigen::VectorXd* x[3] = {&step.x_d, &step.x_v, &step.force};
-  const Eigen::VectorXd res[3] = {s.interface_displacement - step.x_d, s.interface_velocity - step.x_v, r_force};
+  const Eigen::VectorXd res[3] = {displacement_samples(s) - step.x_d, velocity_samples(s) - step.x_v, r_force};
+  // The blocks' sizes: the solid's samples for d and v, the fluid's for F (all equal without
+  // substeps).
+  const Eigen::Index size[3] = {step.x_d.size(), step.x_v.size(), step.force.size()};
+  const Eigen::Index offset[3] = {0, size[0], size[0] + size[1]};
   double* scale = scale_;
   if (step.k == 1) {
     bool renewed = false;
     for (int b = 0; b < 3; ++b) {
-      const double size = std::max({x[b]->norm(), (*x[b] + res[b]).norm(), kScaleFloor * peak_[b]});
-      if (size > c.settings_.residual_floor && (scale[b] == 0 || size > 10 * scale[b] || size < 0.1 * scale[b])) {
-        scale[b] = size, renewed = true;
-        peak_[b] = std::max(peak_[b], size);
+      const double block = std::max({x[b]->norm(), (*x[b] + res[b]).norm(), kScaleFloor * peak_[b]});
+      if (block > c.settings_.residual_floor && (scale[b] == 0 || block > 10 * scale[b] || block < 0.1 * scale[b])) {
+        scale[b] = block, renewed = true;
+        peak_[b] = std::max(peak_[b], block);
       }
     }
     if (renewed && step.n > 1) {
@@ -126,17 +130,18 @@ void Coupler::ParallelScheme::stacked_update(Run& r, const Step& step, Update& u
       r.accelerator->begin_step();
     }
   }
-  Eigen::VectorXd xs(3 * m), rs(3 * m);
+  const Eigen::Index total = size[0] + size[1] + size[2];
+  Eigen::VectorXd xs(total), rs(total);
   for (int b = 0; b < 3; ++b) {
     const double w = scale[b] > 0 ? 1 / scale[b] : 1.0;
-    xs.segment(b * m, m) = w * *x[b];
-    rs.segment(b * m, m) = w * res[b];
+    xs.segment(offset[b], size[b]) = w * *x[b];
+    rs.segment(offset[b], size[b]) = w * res[b];
   }
   const Eigen::VectorXd y = r.accelerator->update(xs, rs);
   u.stacked_change = (y - xs).norm();
   u.stacked_residual = u.stacked_change / std::max(y.norm(), c.settings_.residual_floor);
   Eigen::VectorXd* out[3] = {&u.next_d, &u.next_v, &u.relaxed};
-  for (int b = 0; b < 3; ++b) *out[b] = (scale[b] > 0 ? scale[b] : 1.0) * y.segment(b * m, m);
+  for (int b = 0; b < 3; ++b) *out[b] = (scale[b] > 0 ? scale[b] : 1.0) * y.segment(offset[b], size[b]);
 }
 
 }  // namespace fsi::coupling

@@ -15,28 +15,21 @@ Coupler::Update Coupler::SerialScheme::iterate(Run& r, Step& step) {
   const SolidStepResult& s = it.s;
   {
     Timer t(c.times_.solid);
-    it.s = c.solid_.solve_step(info, step.force);
+    it.s = c.solve_solid(r, step, info, step.force);
   }
-  if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity))
+  if (!all_finite(s.interface_displacement) || !all_finite(s.interface_velocity) ||
+      !all_finite(displacement_samples(s)) || !all_finite(velocity_samples(s)))
     throw Stop{"diverged", fmt::format("solid returned a non-finite interface state at step {} iteration {}", n, k)};
-  Eigen::VectorXd v_f;
-  {
-    Timer t(c.times_.coupler);
-    it.d_f = c.map_.to_fluid(s.interface_displacement);
-    v_f = c.map_.to_fluid(s.interface_velocity);
-  }
   {
     Timer t(c.times_.fluid);
-    it.loads = c.fluid_.solve_step(info, it.d_f, v_f);
+    it.loads = c.solve_fluid(r, step, info, displacement_samples(s), velocity_samples(s), it.d_f);
   }
   Eigen::VectorXd traction_change;
   {
     Timer t(c.times_.coupler);
     it.mass = c.map_mass(r, it.loads);
-    const Eigen::VectorXd fs = c.map_.to_solid(it.loads.traction_force),
-                          fv = c.map_.to_solid(it.loads.velocity_integral);
-    const Eigen::VectorXd f_star = c.robin_force(fs, fv, s.interface_velocity, s.interface_displacement, it.mass);
-    traction_change = c.traction_mismatch(it, fs, fv, s.interface_displacement, s.interface_velocity, step.force);
+    Eigen::VectorXd f_star;
+    c.window_force(r, step, it, displacement_samples(s), velocity_samples(s), f_star, traction_change);
     // r_k = -F* - F^(k); F^(k+1) = F^(k) + beta r_k is the paper's relaxation
     // (acceleration.hpp for Aitken and IQN-ILS).
     u.relaxed = r.accelerator->update(step.force, -f_star - step.force);

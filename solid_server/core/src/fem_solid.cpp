@@ -483,8 +483,49 @@ void FemSolid::newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTe
                     info.step, info.time, rep.iterations, rep.residual, rep.initial_residual));
 }
 
+void FemSolid::set_history(const History& h) {
+  d_n_ = h.d_n, v_n_ = h.v_n, a_n_ = h.a_n, f_n_ = h.f_n, d_nm1_ = h.d_nm1, v_nm1_ = h.v_nm1;
+  accepted_steps_ = h.accepted_steps;
+}
+
+SolidStepResult FemSolid::solve_window(const StepInfo& info, const Waveform& force, int substeps) {
+  if (!system_) throw SolverError("solid: solve_step before configure");
+  Waveform w = force;
+  w.degree = scheme_ == TimeScheme::Bdf1 ? 1 : 2;
+  const History start = history();
+  const double h = info.dt / substeps, t0 = info.time - info.dt;
+  SolidStepResult out;
+  int iterations = 0;
+  try {
+    for (int j = 1; j <= substeps; ++j) {
+      if (j > 1) {  // the last substep becomes the history of the next
+        d_nm1_ = d_n_, v_nm1_ = v_n_;
+        d_n_ = d_, v_n_ = v_, a_n_ = a_, f_n_ = f_;
+        ++accepted_steps_;
+      }
+      const StepInfo sub{substep_time(t0, info.dt, j, substeps), h, info.step, info.iteration};
+      const SolidStepResult r = solve_step(sub, w.at(sub.time));
+      iterations += r.newton_iterations;
+      const Eigen::Index m = r.interface_displacement.size();
+      if (j == 1) out.displacement_samples.resize(m * substeps), out.velocity_samples.resize(m * substeps);
+      out.displacement_samples.segment((j - 1) * m, m) = r.interface_displacement;
+      out.velocity_samples.segment((j - 1) * m, m) = r.interface_velocity;
+      if (j == substeps)
+        out.interface_displacement = r.interface_displacement, out.interface_velocity = r.interface_velocity;
+    }
+  } catch (...) {
+    set_history(start);
+    throw;
+  }
+  window_end_ = history();
+  set_history(start);
+  out.newton_iterations = last_iterations_ = iterations;
+  return out;
+}
+
 SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) {
   if (!system_) throw SolverError("solid: solve_step before configure");
+  window_end_.reset();
   f_ = external_force(interface_force);
   last_iterations_ = 0;
   const double dt = info.dt > 0 ? info.dt : setup_.dt;
@@ -561,6 +602,7 @@ Eigen::VectorXd FemSolid::probe_displacement(const Probe& p, const Eigen::Vector
 
 std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
   if (!solved_) throw SolverError(fmt::format("solid: accept_step {} without a solve_step", info.step));
+  if (window_end_) set_history(*window_end_), window_end_.reset();
   d_nm1_ = d_n_, v_nm1_ = v_n_;
   d_n_ = d_, v_n_ = v_, a_n_ = a_, f_n_ = f_;
   ++accepted_steps_;

@@ -25,6 +25,7 @@
 #include "fsi/common/config.hpp"
 #include "fsi/common/state.hpp"
 #include "fsi/common/vtk_writer.hpp"
+#include "fsi/common/waveform.hpp"
 
 namespace fsi {
 
@@ -102,9 +103,12 @@ struct SolidSetup {
 };
 
 struct SolidStepResult {
-  Eigen::VectorXd interface_displacement;  // dimension * n
+  Eigen::VectorXd interface_displacement;  // dimension * n (at the window's end)
   Eigen::VectorXd interface_velocity;      // dimension * n
   int newton_iterations = 0;
+  // solve_window(): the interface state at the end of every substep, concatenated (substeps
+  // blocks of dimension * n, the last the window's end); empty = one step.
+  Eigen::VectorXd displacement_samples, velocity_samples;
 };
 
 // Inside a long solve, after each nonlinear iteration, a short text for whoever runs the model
@@ -139,6 +143,15 @@ class SolidModel : public IterationReporting {
   // Solves step n+1 for the nodal interface force F^(k)_{n+1} (dimension * n). Repeated calls for the
   // same step restart from the last accepted state.
   virtual SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) = 0;
+  // Waveform iterations (solid.substeps > 1): the window (info.time - info.dt, info.time] in
+  // `substeps` steps of info.dt / substeps from the last accepted state, each with the force
+  // interpolated in time (Waveform::at) at its end; returns every substep's interface state
+  // (SolidStepResult's samples). Repeated calls restart from the window's start; accept_step()
+  // accepts the window's end.
+  virtual bool supports_substeps() const { return false; }
+  virtual SolidStepResult solve_window(const StepInfo& /*info*/, const Waveform& /*force*/, int /*substeps*/) {
+    throw std::logic_error("solid '" + name() + "' does not take substeps");
+  }
   // Makes the last solve the new accepted state; returns named probes.
   virtual std::map<std::string, double> accept_step(const StepInfo& info) = 0;
   virtual std::vector<std::string> write_output(const StepInfo& info) { return {}; }
@@ -182,6 +195,9 @@ struct FluidLoads {
   Eigen::VectorXd velocity_integral;  // f_v = int N^T v_f dgamma (dimension * n)
   int nonlinear_iterations = 0;
   NodalMatrix interface_mass;  // M_f (n x n, current configuration; f_v = M_f v_f); 0 x 0 = not given
+  // solve_window(): traction_force and velocity_integral at the end of every substep,
+  // concatenated (the last = the window's end, also in the two above); empty = one step.
+  Eigen::VectorXd traction_samples, velocity_integral_samples;
 };
 
 // The explicit Robin-Neumann scheme's interface condition on the fluid (coupling.scheme:
@@ -209,6 +225,15 @@ class FluidModel : public IterationReporting {
   // Nitsche's method, solves step n+1 and returns the interface loads.
   virtual FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                 const Eigen::VectorXd& interface_velocity) = 0;
+  // Waveform iterations (fluid.substeps > 1): the window in `substeps` steps of info.dt /
+  // substeps from the last accepted state, the interface displacement and velocity
+  // interpolated in time at each substep's end; returns every substep's loads (FluidLoads'
+  // samples). Repeated calls restart from the window's start.
+  virtual bool supports_substeps() const { return false; }
+  virtual FluidLoads solve_window(const StepInfo& /*info*/, const Waveform& /*displacement*/,
+                                  const Waveform& /*velocity*/, int /*substeps*/) {
+    throw std::logic_error("fluid '" + name() + "' does not take substeps");
+  }
   // The same step with the Robin condition on the interface instead (supports_robin()).
   virtual bool supports_robin() const { return false; }
   virtual FluidLoads solve_robin(const StepInfo& /*info*/, const Eigen::VectorXd& /*interface_displacement*/,

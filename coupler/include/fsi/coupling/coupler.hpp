@@ -154,11 +154,22 @@ class Coupler {
   void save_checkpoint(Run& r, int n, double t_np1);
   // H^T M_f H of a fluid solve (empty when the fluid does not send M_f).
   NodalMatrix map_mass(Run& r, const FluidLoads& loads);
+  // Waveform iterations (solid.substeps, fluid.substeps): the solid's solve of the window with
+  // F^(k) (the fluid's samples); the fluid's with the solid-side interface state (the solid's
+  // samples), it.d_f its end mapped; F* and the traction mismatch sample by sample at the
+  // fluid's substep times (the solid's state interpolated there). With one substep each, the
+  // solves and formulas of a step without waveforms.
+  SolidStepResult solve_solid(const Run& r, const Step& step, const StepInfo& info, const Eigen::VectorXd& force);
+  FluidLoads solve_fluid(const Run& r, const Step& step, const StepInfo& info, const Eigen::VectorXd& d,
+                         const Eigen::VectorXd& v, Eigen::VectorXd& d_f);
+  void window_force(const Run& r, const Step& step, Iterate& it, const Eigen::VectorXd& d, const Eigen::VectorXd& v,
+                    Eigen::VectorXd& f_star, Eigen::VectorXd& mismatch) const;
   void write_output(Run& r, const StepInfo& info, const InterfaceFields& fields);
 
-  bool consistent_damping_ = false;  // Algorithm 2 and the solid takes H^T M_f H
-  double impedance_ratio_ = 0;       // Algorithm 2: gamma_N1 / (m_s / |Gamma| / dt); 0 = unknown
-  double robin_auto_value_ = 0;      // coupling.robin_auto's (m_s / |Gamma|) / dt
+  int solid_substeps_ = 1, fluid_substeps_ = 1;  // solid.substeps, fluid.substeps
+  bool consistent_damping_ = false;              // Algorithm 2 and the solid takes H^T M_f H
+  double impedance_ratio_ = 0;                   // Algorithm 2: gamma_N1 / (m_s / |Gamma| / dt); 0 = unknown
+  double robin_auto_value_ = 0;                  // coupling.robin_auto's (m_s / |Gamma|) / dt
   SolidModel& solid_;
   FluidModel& fluid_;
   const Scene& scene_;

@@ -30,6 +30,10 @@ class SurrogateFluid : public FluidModel {
   InterfaceMeshData interface() const override;
   FluidLoads initial_loads(const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
+  // Substeps of dt / n: the velocity interpolated linearly at each substep's end, its BDF1
+  // acceleration over the substep.
+  bool supports_substeps() const override { return true; }
+  FluidLoads solve_window(const StepInfo& info, const Waveform& d, const Waveform& v, int substeps) override;
   // The Robin condition in closed form, node by node: with the force on the solid
   // w_j (F - m_a (v_j - v_n,j) / dt) = -f_sigma_j, v_j (w_j m_a / dt + A_j) = A_j v*_j + f*_j +
   // w_j F + w_j m_a v_n,j / dt.

@@ -24,6 +24,8 @@ class RemoteSolid : public SolidModel {
   void configure(const ConfigSection& section, const SolidSetup& setup) override;
   InterfaceMeshData interface() const override { return interface_; }
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
+  bool supports_substeps() const override { return supports_substeps_; }
+  SolidStepResult solve_window(const StepInfo& info, const Waveform& force, int substeps) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
@@ -45,6 +47,7 @@ class RemoteSolid : public SolidModel {
   bool supports_interface_mass_ = false;
   NodalMatrix interface_mass_;
   bool send_interface_mass_ = false;  // a new M_G goes with the next SolveStep
+  bool supports_substeps_ = false;
   bool supports_checkpoint_ = false;
   bool supports_output_ = false;
   InterfaceMeshData interface_;
@@ -60,6 +63,8 @@ class RemoteFluid : public FluidModel {
   FluidLoads solve_step(const StepInfo& info, const Eigen::VectorXd& d, const Eigen::VectorXd& v) override;
   bool supports_robin() const override { return supports_robin_; }
   FluidLoads solve_robin(const StepInfo& info, const Eigen::VectorXd& d, const RobinCondition& robin) override;
+  bool supports_substeps() const override { return supports_substeps_; }
+  FluidLoads solve_window(const StepInfo& info, const Waveform& d, const Waveform& v, int substeps) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   std::map<std::string, double> timings() const override { return timings_; }
@@ -80,6 +85,7 @@ class RemoteFluid : public FluidModel {
   bool supports_checkpoint_ = false;
   bool supports_output_ = false;
   bool supports_robin_ = false;
+  bool supports_substeps_ = false;
   InterfaceMeshData interface_;
 };
 

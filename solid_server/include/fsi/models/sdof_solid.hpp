@@ -25,6 +25,9 @@ class SdofSolid : public SolidModel {
   void configure(const ConfigSection& section, const SolidSetup& setup) override;
   InterfaceMeshData interface() const override;
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
+  // Substeps of dt / n from the window's start, BDF1 each (the force interpolated linearly).
+  bool supports_substeps() const override { return true; }
+  SolidStepResult solve_window(const StepInfo& info, const Waveform& force, int substeps) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   bool supports_checkpoint() const override { return true; }
   bool supports_interface_mass() const override { return true; }
@@ -36,6 +39,8 @@ class SdofSolid : public SolidModel {
  private:
   double mass_ = 1, damping_ = 0, stiffness_ = 0, measure_ = 1, interface_damping_ = 0, gamma_ = 0;
   ModelInterface interface_;
+  // One BDF1 step of dt from (d, v) under the interface force; (d, v) become the new state.
+  void bdf1(double dt, const Eigen::VectorXd& interface_force, Eigen::VectorXd& d, Eigen::VectorXd& v) const;
   // One value per component (2 or 3).
   Eigen::VectorXd force_, d_n_, v_n_, d_, v_, d0_, v0_;
 };

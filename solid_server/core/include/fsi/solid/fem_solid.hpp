@@ -69,6 +69,12 @@ class FemSolid : public fsi::SolidModel {
   void configure(const ConfigSection& section, const SolidSetup& setup) override;
   InterfaceMeshData interface() const override { return interface_; }
   SolidStepResult solve_step(const StepInfo& info, const Eigen::VectorXd& interface_force) override;
+  // Waveform iterations (dynamic analyses): substeps of dt / n from the window's start, the
+  // force interpolated in time at each substep's end, linearly for bdf1 and quadratically for
+  // the second-order bdf2 and newmark (through the samples nearest in time, the previous
+  // window's end included when the coupler sends it).
+  bool supports_substeps() const override { return scheme_ != TimeScheme::Static; }
+  SolidStepResult solve_window(const StepInfo& info, const Waveform& force, int substeps) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
   // Checkpoints: the accepted state and the integrator's history (solid.*).
@@ -116,6 +122,15 @@ class FemSolid : public fsi::SolidModel {
   Eigen::VectorXd d_n_, v_n_, a_n_, f_n_;
   Eigen::VectorXd d_nm1_, v_nm1_;  // step n-1 (bdf2), valid once accepted_steps_ >= 1
   int accepted_steps_ = 0;
+  // solve_window(): the history before the window's last substep, from which accept_step()
+  // moves on (the accepted history stays the window's start for the next coupling iteration).
+  struct History {
+    Eigen::VectorXd d_n, v_n, a_n, f_n, d_nm1, v_nm1;
+    int accepted_steps = 0;
+  };
+  std::optional<History> window_end_;
+  History history() const { return {d_n_, v_n_, a_n_, f_n_, d_nm1_, v_nm1_, accepted_steps_}; }
+  void set_history(const History& h);
   Eigen::VectorXd d_, v_, a_, f_;
   int last_iterations_ = 0;
   bool solved_ = false;
