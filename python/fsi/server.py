@@ -39,7 +39,9 @@ The methods (positional arguments, in this order):
 ``configure(section, dt, end_time, interface_damping, output_dir) -> Interface``
     ``section`` is your part of the scene (a dict, ``--set`` overrides applied); the whole
     scene is ``self.scene``, its path ``self.scene_path``. Raise ``InvalidArgument`` for a
-    bad key (the run stops, naming it). A ``configure`` without an ``interface_damping``
+    bad key (the run stops, naming it); ``fsi.section.Section(section, "solid")`` reads keys
+    strictly (types, ranges, and ``check_all_used()`` names every key nobody read), its
+    ``SceneError`` answered the same way. A ``configure`` without an ``interface_damping``
     parameter (e.g. ``configure(self, section, dt, end_time)``) declares that the solid
     cannot run Algorithm 2 with gamma > 0 (``supports_interface_damping = False``);
     parameters are then passed by name. Return an ``Interface`` (or a dict of its
@@ -98,6 +100,7 @@ _require("numpy", "yaml", "zmq", "google.protobuf")  # a script under another py
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
+from fsi.section import SceneError, Section  # noqa: E402,F401 - the strict section reader, for solids
 from fsi.v1 import coupling_pb2 as pb  # noqa: E402
 
 VERSION = 1
@@ -412,7 +415,7 @@ class Server:
         stop = False
         try:
             stop = self._dispatch(body, request, reply, peer)
-        except InvalidArgument as e:
+        except (InvalidArgument, SceneError) as e:
             self._error(reply, pb.Error.INVALID_ARGUMENT, str(e))
         except _BadSequence as e:
             self._error(reply, pb.Error.BAD_SEQUENCE, str(e))
