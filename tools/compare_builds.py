@@ -5,7 +5,8 @@ build's `fsi` and compares probes.csv and iterations.csv byte for byte.
   /usr/bin/python3 tools/compare_builds.py BUILD_A BUILD_B [--out DIR] [--scene NAME:ARGS ...]
 
 BUILD_A, BUILD_B: build folders (holding bin/fsi), e.g. one of an older commit in a git worktree
-and the current one. Run both on the same machine: the tables are reproducible bit for bit on
+and the current one. Keys that only label (`units`) are left out of both runs' scenes, so a
+build older than them runs the same scenes. Run both on the same machine: the tables are reproducible bit for bit on
 one machine and library set, not across CPUs (BLAS kernels differ). Exit 0 when every table is
 identical, 1 otherwise (the first differing line is printed). A regression guard for changes
 that must not move a 2D number (a restructuring, a new dimension), as the 3D plug-ins were.
@@ -40,6 +41,25 @@ def run(fsi, args, out):
     return p.returncode, p.stdout + p.stderr
 
 
+# Top-level keys that change no number (labels only): an older build refuses them, so both
+# builds get a copy of the scene without them when the scene has them.
+LABEL_KEYS = ("units",)
+
+
+def without_label_keys(args):
+    """(args, temporary scene or None): args with the scene file replaced by a copy beside it
+    (relative mesh paths still resolve) that lacks LABEL_KEYS, when the scene has any."""
+    words = shlex.split(args)
+    scene = SRC / words[0]
+    lines = scene.read_text().splitlines(keepends=True)
+    kept = [ln for ln in lines if not any(ln.startswith(k + ":") for k in LABEL_KEYS)]
+    if len(kept) == len(lines):
+        return args, None
+    copy = scene.with_name(f".compare_{os.getpid()}_{scene.name}")
+    copy.write_text("".join(kept))
+    return shlex.join([str(copy.relative_to(SRC))] + words[1:]), copy
+
+
 def first_difference(a, b):
     la, lb = a.read_text().splitlines(), b.read_text().splitlines()
     for i, (x, y) in enumerate(zip(la, lb)):
@@ -64,12 +84,17 @@ def main():
     bad = 0
     for name, args in cases.items():
         results = []
-        for tag, build in (("a", a.build_a), ("b", a.build_b)):
-            folder = out / name / tag
-            code, log = run(build.resolve() / "bin" / "fsi", args, folder)
-            if code != 0:
-                print(f"{name}: build {tag} exited {code}:\n{log[-1500:]}")
-            results.append(folder)
+        args, copy = without_label_keys(args)
+        try:
+            for tag, build in (("a", a.build_a), ("b", a.build_b)):
+                folder = out / name / tag
+                code, log = run(build.resolve() / "bin" / "fsi", args, folder)
+                if code != 0:
+                    print(f"{name}: build {tag} exited {code}:\n{log[-1500:]}")
+                results.append(folder)
+        finally:
+            if copy is not None:
+                copy.unlink()
         same = []
         for table in ("probes.csv", "iterations.csv"):
             pa, pb = results[0] / table, results[1] / table
