@@ -207,49 +207,19 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
 
   // Dead pressures: -p int N n0 dA with n0 the outward normal of the reference configuration,
   // oriented away from the cell that holds the facet (whatever the facet's node order).
-  if (!s.list("pressures").empty()) {
-    std::map<std::vector<int>, int> cell_of;  // sorted facet nodes -> a cell holding them
-    std::map<int, std::vector<int>> cells_of_node;
-    for (int c = 0; c < mesh_.num_cells(); ++c)
-      for (int v : mesh_.cells[static_cast<std::size_t>(c)]) cells_of_node[v].push_back(c);
-    auto holder = [&](const Facet& f) {
-      for (int c : cells_of_node[f[0]]) {
-        const auto& cell = mesh_.cells[static_cast<std::size_t>(c)];
-        if (std::all_of(f.begin(), f.end(),
-                        [&](int v) { return std::find(cell.begin(), cell.end(), v) != cell.end(); }))
-          return c;
-      }
-      return -1;
-    };
-    for (const auto& p : s.list("pressures")) {
-      const double pressure = p.get<double>("pressure");
-      std::vector<Facet> facets;
-      try {
-        facets = mesh_.facets(p.names("boundary"));
-      } catch (const std::invalid_argument& e) {
-        p.fail("boundary", e.what());
-      }
-      for (const auto& f : facets) {
-        const int c = holder(f);
-        if (c < 0) p.fail("boundary", "a facet that is no cell's side");
-        Eigen::VectorXd centre = Eigen::VectorXd::Zero(dim), facet_centre = Eigen::VectorXd::Zero(dim);
-        for (int v : mesh_.cells[static_cast<std::size_t>(c)]) centre += mesh_.nodes.row(v).transpose();
-        centre /= static_cast<double>(mesh_.cells[static_cast<std::size_t>(c)].size());
-        for (int v : f) facet_centre += mesh_.nodes.row(v).transpose() / static_cast<double>(f.size());
-        Eigen::MatrixXd a(f.size(), dim);  // int N_a n dA, per node
-        if (dim == 2) {
-          const Eigen::Vector2d t = mesh_.nodes.row(f[1]) - mesh_.nodes.row(f[0]);
-          a.row(0) = a.row(1) = 0.5 * Eigen::RowVector2d(t.y(), -t.x());
-        } else {
-          Eigen::Matrix<double, 4, 3> X;
-          for (int k = 0; k < 4; ++k) X.row(k) = mesh_.nodes.row(f[static_cast<std::size_t>(k)]);
-          a = quad_face_area_vectors(X);
-        }
-        const double sign = (facet_centre - centre).dot(a.colwise().sum().transpose()) < 0 ? -1.0 : 1.0;
-        for (std::size_t k = 0; k < f.size(); ++k)
-          dead_load_.segment(dim * f[k], dim) -= sign * pressure * a.row(static_cast<Eigen::Index>(k)).transpose();
-      }
+  for (const auto& p : s.list("pressures")) {
+    const double pressure = p.get<double>("pressure");
+    std::vector<Facet> facets;
+    std::vector<Eigen::MatrixXd> area;
+    try {
+      facets = mesh_.facets(p.names("boundary"));
+      area = outward_area_vectors(mesh_, facets);
+    } catch (const std::invalid_argument& e) {
+      p.fail("boundary", e.what());
     }
+    for (std::size_t i = 0; i < facets.size(); ++i)
+      for (std::size_t k = 0; k < facets[i].size(); ++k)
+        dead_load_.segment(dim * facets[i][k], dim) -= pressure * area[i].row(static_cast<Eigen::Index>(k)).transpose();
   }
 
   for (const auto& p : s.list("point_loads")) {  // force at the node nearest to a point

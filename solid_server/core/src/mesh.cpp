@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "fsi/common/gmsh_reader.hpp"
+#include "fsi/solid/element.hpp"
 
 namespace fsi::solid {
 
@@ -24,6 +25,43 @@ std::vector<Facet> unique_facets(const std::vector<Facet>& facets) {
     if (seen.insert(key).second) unique.push_back(f);
   }
   return unique;
+}
+
+std::vector<Eigen::MatrixXd> outward_area_vectors(const SolidMesh& mesh, const std::vector<Facet>& facets) {
+  const int dim = mesh.dim;
+  std::map<int, std::vector<int>> cells_of_node;
+  for (int c = 0; c < mesh.num_cells(); ++c)
+    for (int v : mesh.cells[static_cast<std::size_t>(c)]) cells_of_node[v].push_back(c);
+  auto holder = [&](const Facet& f) {
+    for (int c : cells_of_node[f[0]]) {
+      const auto& cell = mesh.cells[static_cast<std::size_t>(c)];
+      if (std::all_of(f.begin(), f.end(), [&](int v) { return std::find(cell.begin(), cell.end(), v) != cell.end(); }))
+        return c;
+    }
+    return -1;
+  };
+  std::vector<Eigen::MatrixXd> out;
+  out.reserve(facets.size());
+  for (const auto& f : facets) {
+    const int c = holder(f);
+    if (c < 0) throw std::invalid_argument("a facet that is no cell's side");
+    Eigen::VectorXd centre = Eigen::VectorXd::Zero(dim), facet_centre = Eigen::VectorXd::Zero(dim);
+    for (int v : mesh.cells[static_cast<std::size_t>(c)]) centre += mesh.nodes.row(v).transpose();
+    centre /= static_cast<double>(mesh.cells[static_cast<std::size_t>(c)].size());
+    for (int v : f) facet_centre += mesh.nodes.row(v).transpose() / static_cast<double>(f.size());
+    Eigen::MatrixXd a(f.size(), dim);  // int N_a n dA, per node
+    if (dim == 2) {
+      const Eigen::Vector2d t = mesh.nodes.row(f[1]) - mesh.nodes.row(f[0]);
+      a.row(0) = a.row(1) = 0.5 * Eigen::RowVector2d(t.y(), -t.x());
+    } else {
+      Eigen::Matrix<double, 4, 3> X;
+      for (int k = 0; k < 4; ++k) X.row(k) = mesh.nodes.row(f[static_cast<std::size_t>(k)]);
+      a = quad_face_area_vectors(X);
+    }
+    if ((facet_centre - centre).dot(a.colwise().sum().transpose()) < 0) a = -a;
+    out.push_back(std::move(a));
+  }
+  return out;
 }
 
 std::vector<Facet> SolidMesh::facets(const std::vector<std::string>& names) const {

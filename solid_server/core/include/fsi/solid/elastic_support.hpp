@@ -9,7 +9,6 @@
 // the displacement: residual += K_s u, tangent += K_s, with K_s = k_s A n n^T (or k_s A I) per
 // node. A kernel: Eigen in, Eigen out; no I/O.
 #include <Eigen/Core>
-#include <Eigen/Geometry>
 #include <vector>
 
 #include "fsi/solid/mesh.hpp"

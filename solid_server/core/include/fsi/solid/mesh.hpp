@@ -36,6 +36,11 @@ struct SolidMesh {
 // order of first appearance.
 std::vector<Facet> unique_facets(const std::vector<Facet>& facets);
 
+// int N_a n0 dA of each node a of each facet (f.size() x dim per facet), n0 the outward normal
+// of the reference configuration: oriented away from the cell that holds the facet, whatever
+// the facet's node order. Throws std::invalid_argument for a facet that is no cell's side.
+std::vector<Eigen::MatrixXd> outward_area_vectors(const SolidMesh& mesh, const std::vector<Facet>& facets);
+
 // Structured nx x ny Q4 mesh of [x0, x0+lx] x [y0, y0+ly]; edge sets "left", "right",
 // "bottom", "top". Node (i, j) has id j * (nx + 1) + i.
 SolidMesh rectangle_mesh(double x0, double y0, double lx, double ly, int nx, int ny);
