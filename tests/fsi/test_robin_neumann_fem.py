@@ -9,12 +9,11 @@ through the real processes (fsi run; about 4 s per run):
     docs/fsi.md reports.
 """
 import argparse
-import csv
-import json
 import os
-import subprocess
 import sys
 import tempfile
+
+from fsi_run import run_scene
 
 REFERENCE_AX_025 = 0.57827  # Algorithm 1, k_max 10, gamma_N1 100, beta 0.02, dt 0.005 (docs/fsi.md)
 RN = ["coupling.scheme=robin-neumann", "coupling.algorithm=1", "coupling.gamma_n1=0", "coupling.relaxation=1",
@@ -22,16 +21,9 @@ RN = ["coupling.scheme=robin-neumann", "coupling.algorithm=1", "coupling.gamma_n
 
 
 def run(a, out, sets):
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_WAIT_POLICY="passive")
-    cmd = [os.path.join(a.bin, "fsi"), "run", os.path.join(a.source, "configs", "thin_beam.yaml"), "--out", out]
-    for s in sets:
-        cmd += ["--set", s]
-    print(" ".join(cmd), flush=True)
-    subprocess.run(cmd, env=env, timeout=120, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    summary = json.load(open(os.path.join(out, "summary.json")))
-    probes = list(csv.DictReader(open(os.path.join(out, "probes.csv"))))
-    iterations = list(csv.DictReader(open(os.path.join(out, "iterations.csv"))))
-    print(f"  {summary['status']} after {summary['steps']} steps: {summary.get('reason', '')}", flush=True)
+    _, _, summary, probes, iterations = run_scene(a.bin, os.path.join(a.source, "configs", "thin_beam.yaml"), out,
+                                                  sets, timeout=300)
+    print(f"  {summary.get('status')} after {summary.get('steps')} steps: {summary.get('reason', '')}", flush=True)
     return summary, probes, iterations
 
 

@@ -13,13 +13,12 @@ Runs the scene to t = 6 ms with Algorithm 1 and with Algorithm 2 (both converged
 Measured (level 0, 100 x 4 wall cells): 5.6-5.8 m/s over the whole run (bench/fsi/tube_waves.py).
 """
 import argparse
-import csv
-import json
 import math
 import os
-import subprocess
 import sys
 import tempfile
+
+from fsi_run import run_scene
 
 E, H, R, RHO_F = 3.0e6, 0.1, 0.5, 1.0
 THRESHOLD = 5000.0  # dyn/cm^2
@@ -42,23 +41,18 @@ def main():
     ap.add_argument("--bin", required=True)
     ap.add_argument("--source", required=True)
     a = ap.parse_args()
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
     failures = []
     result = {}
     with tempfile.TemporaryDirectory(prefix="tube_2d_") as tmp:
         for algorithm in (1, 2):
             out = os.path.join(tmp, f"a{algorithm}")
-            cmd = [os.path.join(a.bin, "fsi"), "run", os.path.join(a.source, "configs", "tube_2d.yaml"), "--out", out,
-                   "--set", "time.end=0.006", "--set", f"coupling.algorithm={algorithm}",
-                   "--set", "coupling.iterations.tolerance=1e-8"]
-            print(" ".join(cmd), flush=True)
-            r = subprocess.run(cmd, env=env, timeout=300, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            summary = json.load(open(os.path.join(out, "summary.json")))
-            if r.returncode != 0 or summary.get("status") != "completed":
-                print(r.stdout[-4000:])
-                print(f"FAIL: Algorithm {algorithm}: exit {r.returncode}, {summary.get('status')}: {summary.get('reason')}")
+            code, output, summary, rows, _ = run_scene(
+                a.bin, os.path.join(a.source, "configs", "tube_2d.yaml"), out,
+                ["time.end=0.006", f"coupling.algorithm={algorithm}", "coupling.iterations.tolerance=1e-8"])
+            if code != 0 or summary.get("status") != "completed":
+                print(output[-4000:])
+                print(f"FAIL: Algorithm {algorithm}: exit {code}, {summary.get('status')}: {summary.get('reason')}")
                 return 1
-            rows = list(csv.DictReader(open(os.path.join(out, "probes.csv"))))
             t1, t2 = arrival(rows, "fluid.p1"), arrival(rows, "fluid.p2")
             its = sum(float(x["coupling.iterations"]) for x in rows) / len(rows)
             result[algorithm] = (t1, t2, float(rows[-1]["solid.r1_y"]))
