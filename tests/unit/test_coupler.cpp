@@ -706,7 +706,9 @@ TEST(Parallel, JacobiRelaxationLimitIsTheSerialOne) {
       scene.insert(scene.end(), robin.begin(), robin.end());
       const auto run = run_scene(scene);
       EXPECT_EQ(run.outcome.status, factor < 1 ? "completed" : "diverged") << robin.back() << " " << factor;
-      if (factor > 1) EXPECT_EQ(run.outcome.steps, 0) << robin.back();
+      if (factor > 1) {
+        EXPECT_EQ(run.outcome.steps, 0) << robin.back();
+      }
     }
   }
 }
