@@ -105,7 +105,8 @@ class ObstacleContact {
 };
 
 // The lumped measure of each node of the facets (2D: half of each edge; 3D: the bilinear
-// faces' int N_a dA), size = number of mesh nodes.
+// faces' int N_a dA, the 6-node triangles' HRZ shares: face_lumped_weights), size = number
+// of mesh nodes.
 Eigen::VectorXd lumped_facet_measure(const SolidMesh& mesh, const std::vector<Facet>& facets);
 
 }  // namespace fsi::solid
