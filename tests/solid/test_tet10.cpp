@@ -4,6 +4,7 @@
 // facet sets and bad input refused, a cantilever against Timoshenko's beam and the Hex8Eas
 // result, and CSM1 on the shipped tetrahedron mesh.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -472,4 +473,99 @@ TEST(Csm1Tet10, ShippedSceneNearTheReference) {
     EXPECT_NE(what.find("solid.element"), std::string::npos) << what;
     EXPECT_NE(what.find("give tet10"), std::string::npos) << what;
   }
+}
+
+// ------------------------------------------------------------------ FemSolid on a tet10 .msh
+namespace {
+// A gmsh tet10 box [0, 1] x [0, 0.5] x [0, 0.5] (4 x 2 x 2 cubes) in a fresh folder, and a
+// scene on it: rollers on left (x), bottom (y), back (z), a pressure p on right, and `extra`.
+struct TetBox {
+  std::filesystem::path folder;
+  std::string scene(double p, const std::string& extra) const {
+    return R"(
+solid:
+  model: fem
+  mesh: {type: gmsh, file: )" +
+           (folder / "box.msh").string() + R"(}
+  material: {law: saint_venant_kirchhoff, youngs_modulus: 1000.0, poisson_ratio: 0.3}
+  density: 1.0
+  analysis: static
+  supports: [{boundary: left, fixed: [x]}, {boundary: bottom, fixed: [y]}, {boundary: back, fixed: [z]}]
+  pressures: [{boundary: right, pressure: )" +
+           std::to_string(p) + R"(}]
+  probes: [{name: end, point: [1.0, 0.5, 0.5]}]
+  newton: {residual_tolerance: 1.0e-12}
+)" + extra;
+  }
+};
+TetBox tet_box() {
+  TetBox b{std::filesystem::temp_directory_path() / ("fsi_tet10_" + std::to_string(::getpid()))};
+  std::filesystem::create_directories(b.folder);
+  std::ofstream(b.folder / "box.msh") << to_msh(box_tet_mesh({0, 0, 0}, {1.0, 0.5, 0.5}, 4, 2, 2));
+  return b;
+}
+}  // namespace
+
+// Uniaxial stress by a dead pressure on 6-node facets: u = -p L / E at the end, +nu p / E x 0.5
+// sideways; with a normal elastic support k on the loaded face, p = (E / L + k) |u| (its
+// int N_a dA shares meet the pressure's distribution, so the state stays uniform). The
+// interface of tri6 faces carries their area; the VTK cells are VTK's quadratic tetrahedra.
+TEST(Tet10Scene, PressureSupportInterfaceAndVtk) {
+  const TetBox box = tet_box();
+  const double p = 1e-3, E = 1000.0, nu = 0.3;
+  auto run = [&](const std::string& extra, const std::filesystem::path& out = {}) {
+    const auto scene = fsi::Scene::parse(box.scene(p, extra), "box.yaml");
+    FemSolid solid;
+    auto section = scene.section("solid");
+    section.get<std::string>("model");
+    solid.configure(section, fsi::SolidSetup{1.0, 1.0, 0, out, fsi::VtkFormat::Ascii});
+    const fsi::StepInfo info{1.0, 1.0, 1, 0};
+    solid.solve_step(info, Eigen::VectorXd());
+    auto probes = solid.accept_step(info);
+    if (!out.empty()) solid.write_output(info);
+    return std::make_pair(probes, solid.interface());
+  };
+  const auto [free, iface] = run("  interface: [top, right]\n  output_every: 1\n", box.folder / "vtk");
+  EXPECT_NEAR(free.at("end_x") / (-p / E), 1.0, 1e-5);
+  EXPECT_NEAR(free.at("end_y") / (nu * p / E * 0.5), 1.0, 1e-5);
+  EXPECT_NEAR(free.at("end_z") / (nu * p / E * 0.5), 1.0, 1e-5);
+  const double k = 3000.0;
+  const auto supported = run("  elastic_supports: [{boundary: right, stiffness: 3000.0}]\n").first;
+  EXPECT_NEAR(supported.at("end_x") / (-p / (E + k)), 1.0, 1e-5);
+
+  ASSERT_EQ(iface.dimension, 3);
+  EXPECT_EQ(iface.faces.size(), 2u * (4 * 2 + 2 * 2));  // two triangles per square
+  for (const auto& f : iface.faces) EXPECT_EQ(f.nodes.size(), 6u);
+  EXPECT_NEAR(iface.lumped_measure.sum(), 1.0 * 0.5 + 0.5 * 0.5, 1e-14);
+
+  // VTK: cell type 24, node 8 the midpoint of 1-3 and node 9 of 2-3 (straight edges).
+  std::filesystem::path vtu;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(box.folder / "vtk"))
+    if (e.path().extension() == ".vtu") vtu = e.path();
+  ASSERT_FALSE(vtu.empty());
+  const std::string text = read_text(vtu);
+  auto array = [&](const std::string& name) {
+    const auto at =
+        name == "Points" ? text.find("<DataArray", text.find("<Points>")) : text.find("Name=\"" + name + "\"");
+    if (at == std::string::npos) throw std::runtime_error("no " + name + " in the .vtu");
+    const auto begin = text.find('>', at) + 1, end = text.find("</DataArray>", begin);
+    std::istringstream in(text.substr(begin, end - begin));
+    std::vector<double> v;
+    for (double x; in >> x;) v.push_back(x);
+    return v;
+  };
+  const auto points = array("Points"), connectivity = array("connectivity"), types = array("types");
+  ASSERT_EQ(types.size(), 96u);
+  for (double t : types) EXPECT_EQ(t, 24.0);
+  ASSERT_EQ(connectivity.size(), 960u);
+  auto point = [&](double n) {
+    const auto i = static_cast<std::size_t>(n);
+    return Eigen::Vector3d(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+  };
+  for (std::size_t c = 0; c < 96; ++c) {
+    const double* cell = &connectivity[10 * c];
+    EXPECT_NEAR((point(cell[8]) - 0.5 * (point(cell[1]) + point(cell[3]))).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((point(cell[9]) - 0.5 * (point(cell[2]) + point(cell[3]))).norm(), 0.0, 1e-12);
+  }
+  std::filesystem::remove_all(box.folder);
 }

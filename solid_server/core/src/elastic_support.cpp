@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "fsi/solid/contact.hpp"
-#include "fsi/solid/element.hpp"
 
 namespace fsi::solid {
 
@@ -16,7 +15,8 @@ ElasticSupport::ElasticSupport(const SolidMesh& mesh, const std::vector<SupportS
     const SupportSpec& spec = supports[s];
     if (!(spec.stiffness > 0))
       throw std::invalid_argument(fmt::format("elastic support {}: the stiffness must be > 0", s));
-    const Eigen::VectorXd area = lumped_facet_measure(mesh, spec.facets);
+    // int N_a dA (0 at the vertices of a flat 6-node triangle, whose int N_a n0 dA is 0 too).
+    const Eigen::VectorXd area = lumped_facet_measure(mesh, spec.facets, FacetLumping::RowSum);
     // The node's outward normal: the sum of its facets' int N_a n0 dA (outward_area_vectors).
     Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(mesh.num_nodes(), dim_);
     std::vector<Eigen::MatrixXd> vectors;
@@ -25,19 +25,9 @@ ElasticSupport::ElasticSupport(const SolidMesh& mesh, const std::vector<SupportS
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(fmt::format("elastic support {}: {}", s, e.what()));
     }
-    for (std::size_t i = 0; i < spec.facets.size(); ++i) {
-      const Facet& f = spec.facets[i];
-      if (f.size() == 6) {  // int N_a n0 dA vanishes at the vertices of a flat 6-node triangle:
-        // the facet's int n0 dA shared by the lumped weights instead
-        Eigen::MatrixXd X(6, 3);
-        for (std::size_t a = 0; a < 6; ++a) X.row(static_cast<Eigen::Index>(a)) = mesh.nodes.row(f[a]);
-        const Eigen::VectorXd w = face_lumped_weights(X);
-        const Eigen::RowVectorXd total = vectors[i].colwise().sum();
-        for (std::size_t a = 0; a < 6; ++a) normal.row(f[a]) += w(static_cast<Eigen::Index>(a)) / w.sum() * total;
-        continue;
-      }
-      for (std::size_t a = 0; a < f.size(); ++a) normal.row(f[a]) += vectors[i].row(static_cast<Eigen::Index>(a));
-    }
+    for (std::size_t i = 0; i < spec.facets.size(); ++i)
+      for (std::size_t a = 0; a < spec.facets[i].size(); ++a)
+        normal.row(spec.facets[i][a]) += vectors[i].row(static_cast<Eigen::Index>(a));
     for (int a = 0; a < mesh.num_nodes(); ++a) {
       if (!(area(a) > 0)) continue;
       Eigen::MatrixXd block = spec.stiffness * area(a) * Eigen::MatrixXd::Identity(dim_, dim_);
