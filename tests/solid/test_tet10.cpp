@@ -537,6 +537,7 @@ TEST(Tet10Scene, PressureSupportInterfaceAndVtk) {
   EXPECT_EQ(iface.faces.size(), 2u * (4 * 2 + 2 * 2));  // two triangles per square
   for (const auto& f : iface.faces) EXPECT_EQ(f.nodes.size(), 6u);
   EXPECT_NEAR(iface.lumped_measure.sum(), 1.0 * 0.5 + 0.5 * 0.5, 1e-14);
+  EXPECT_GT(iface.lumped_measure.minCoeff(), 0.0);  // the protocol refuses a node without measure
 
   // VTK: cell type 24, node 8 the midpoint of 1-3 and node 9 of 2-3 (straight edges).
   std::filesystem::path vtu;

@@ -273,7 +273,18 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
       for (int v : f) face.nodes.push_back(local[v]);
       interface_.faces.push_back(face);
     }
-    if (!interface_.faces.empty()) interface_.lumped_measure = lumped_interface_measure(interface_);
+    // The row sums of int N^T N (the nodal areas of bilinear faces); those of a 6-node
+    // triangle vanish at its vertices, and the protocol wants every node's measure > 0: the
+    // HRZ shares there (lumped_facet_measure, the same total area).
+    const bool quadratic =
+        std::any_of(iface_edges.begin(), iface_edges.end(), [](const Facet& f) { return f.size() == 6; });
+    if (quadratic) {
+      const Eigen::VectorXd measure = lumped_facet_measure(mesh_, unique_facets(iface_edges));
+      for (std::size_t i = 0; i < interface_nodes_.size(); ++i)
+        interface_.lumped_measure(static_cast<Eigen::Index>(i)) = measure(interface_nodes_[i]);
+    } else if (!interface_.faces.empty()) {
+      interface_.lumped_measure = lumped_interface_measure(interface_);
+    }
   }
   // The solid's mass over its interface measure (the automatic Robin parameter's m_s / |Gamma|):
   // the consistent mass matrix sums to dim rho |Omega_s| (one per component).
