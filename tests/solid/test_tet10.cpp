@@ -570,3 +570,25 @@ TEST(Tet10Scene, PressureSupportInterfaceAndVtk) {
   }
   std::filesystem::remove_all(box.folder);
 }
+
+// Contact on 6-node triangles: every node of the facets (vertices too, by their HRZ shares)
+// is a contact node, and a uniform penetration d gives the force p(g) x the face's area.
+TEST(Tet10Contact, EveryFacetNodeIsAContactNode) {
+  const SolidMesh m = box_tet_mesh({0, 0, 0}, {1.0, 0.5, 0.5}, 2, 1, 1);
+  Obstacle o;
+  o.point = Eigen::Vector3d(0, -0.1, 0);
+  o.normal = Eigen::Vector3d(0, 1, 0);
+  o.contact_gap = 0.05;
+  o.stiffness = 100.0;
+  const std::vector<Facet> bottom = m.facet_sets.at("bottom");
+  const ObstacleContact contact(m, {o}, {bottom}, std::vector<char>(static_cast<std::size_t>(3 * m.num_nodes()), 0));
+  EXPECT_EQ(contact.candidates(0), static_cast<int>(m.facet_nodes({"bottom"}).size()));
+  EXPECT_EQ(contact.candidates(0), 15);  // 6 vertices and 9 edge midpoints of a 2 x 1 grid of squares cut in two
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(3 * m.num_nodes());
+  for (int n = 0; n < m.num_nodes(); ++n) d(3 * n + 1) = -0.07;  // gap 0.1 - 0.07 = 0.03 < 0.05 everywhere
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * m.num_nodes());
+  contact.add_to_residual(d, r);
+  double fy = 0;
+  for (int n = 0; n < m.num_nodes(); ++n) fy -= r(3 * n + 1);  // r holds -F_contact
+  EXPECT_NEAR(fy / (contact_pressure(o, 0.03) * 1.0 * 0.5), 1.0, 1e-12);
+}
