@@ -43,6 +43,8 @@ int nodes_per_element(int type) {
       return 4;  // tet4
     case 11:
       return 10;  // tet10
+    case 5:
+      return 8;  // hex8
     default:
       return 0;
   }

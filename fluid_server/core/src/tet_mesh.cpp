@@ -102,6 +102,11 @@ TetMesh TetMesh::from_gmsh(const GmshMesh& mesh, const std::vector<std::string>&
     if (g.dimension != 3) continue;
     if (!domain_groups.empty() && std::find(domain_groups.begin(), domain_groups.end(), g.name) == domain_groups.end())
       continue;
+    if (g.element_type != 4 && g.element_type != 11)
+      throw std::runtime_error(
+          fmt::format("{}: group '{}' has gmsh element type {}; the 3D fluid takes 4-node or "
+                      "10-node tetrahedra",
+                      mesh.source.string(), g.name, g.element_type));
     if (cell_type != 0 && g.element_type != cell_type)
       throw std::runtime_error(
           fmt::format("{}: the fluid groups mix 4-node and 10-node tetrahedra", mesh.source.string()));

@@ -21,17 +21,17 @@ double contact_pressure_derivative(const Obstacle& o, double g) {
   return -2 * o.stiffness * (o.contact_gap - g) / o.contact_gap;
 }
 
-Eigen::VectorXd lumped_facet_measure(const SolidMesh& mesh, const std::vector<Facet>& facets) {
+Eigen::VectorXd lumped_facet_measure(const SolidMesh& mesh, const std::vector<Facet>& facets, FacetLumping lumping) {
   Eigen::VectorXd m = Eigen::VectorXd::Zero(mesh.num_nodes());
   for (const auto& f : facets) {
     if (mesh.dim == 2) {
       const double L = (mesh.nodes.row(f[0]) - mesh.nodes.row(f[1])).norm();
       for (int n : f) m(n) += 0.5 * L;
-    } else {
-      Eigen::Matrix<double, 4, 3> X;
-      for (int a = 0; a < 4; ++a) X.row(a) = mesh.nodes.row(f[static_cast<std::size_t>(a)]);
-      const Eigen::Vector4d w = quad_face_weights(X);
-      for (int a = 0; a < 4; ++a) m(f[static_cast<std::size_t>(a)]) += w(a);
+    } else {  // bilinear quadrilaterals: int N_a dA; 6-node triangles: HRZ or int N_a dA
+      Eigen::MatrixXd X(f.size(), 3);
+      for (std::size_t a = 0; a < f.size(); ++a) X.row(static_cast<Eigen::Index>(a)) = mesh.nodes.row(f[a]);
+      const Eigen::VectorXd w = lumping == FacetLumping::Positive ? face_lumped_weights(X) : face_weights(X);
+      for (std::size_t a = 0; a < f.size(); ++a) m(f[a]) += w(static_cast<Eigen::Index>(a));
     }
   }
   return m;

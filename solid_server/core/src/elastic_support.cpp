@@ -15,7 +15,8 @@ ElasticSupport::ElasticSupport(const SolidMesh& mesh, const std::vector<SupportS
     const SupportSpec& spec = supports[s];
     if (!(spec.stiffness > 0))
       throw std::invalid_argument(fmt::format("elastic support {}: the stiffness must be > 0", s));
-    const Eigen::VectorXd area = lumped_facet_measure(mesh, spec.facets);
+    // int N_a dA (0 at the vertices of a flat 6-node triangle, whose int N_a n0 dA is 0 too).
+    const Eigen::VectorXd area = lumped_facet_measure(mesh, spec.facets, FacetLumping::RowSum);
     // The node's outward normal: the sum of its facets' int N_a n0 dA (outward_area_vectors).
     Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(mesh.num_nodes(), dim_);
     std::vector<Eigen::MatrixXd> vectors;

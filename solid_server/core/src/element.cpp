@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "fsi/common/interface_geometry.hpp"
+
 namespace fsi::solid {
 
 namespace {
@@ -93,6 +95,65 @@ Eigen::Matrix<double, 6, 9> Hex8::enhanced_modes(const Point& p) {
   M(5, 7) = p(0);
   M(5, 8) = p(2);
   return M;
+}
+
+// Tet10: barycentric L0 = 1 - xi - eta - zeta, L1 = xi, L2 = eta, L3 = zeta; vertices
+// L_a (2 L_a - 1), edge midpoints 4 L_a L_b.
+namespace {
+constexpr int kTetEdges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {2, 3}, {1, 3}};
+// dL_a/dxi.
+constexpr double kTetDL[4][3] = {{-1, -1, -1}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+}  // namespace
+
+Eigen::Matrix<double, 10, 1> Tet10::shape(const Point& p) {
+  const double L[4] = {1 - p(0) - p(1) - p(2), p(0), p(1), p(2)};
+  Eigen::Matrix<double, 10, 1> N;
+  for (int a = 0; a < 4; ++a) N(a) = L[a] * (2 * L[a] - 1);
+  for (int e = 0; e < 6; ++e) N(4 + e) = 4 * L[kTetEdges[e][0]] * L[kTetEdges[e][1]];
+  return N;
+}
+
+Eigen::Matrix<double, 10, 3> Tet10::derivatives(const Point& p) {
+  const double L[4] = {1 - p(0) - p(1) - p(2), p(0), p(1), p(2)};
+  Eigen::Matrix<double, 10, 3> dN;
+  for (int k = 0; k < 3; ++k) {
+    for (int a = 0; a < 4; ++a) dN(a, k) = (4 * L[a] - 1) * kTetDL[a][k];
+    for (int e = 0; e < 6; ++e) {
+      const int a = kTetEdges[e][0], b = kTetEdges[e][1];
+      dN(4 + e, k) = 4 * (kTetDL[a][k] * L[b] + L[a] * kTetDL[b][k]);
+    }
+  }
+  return dN;
+}
+
+const std::array<std::pair<Tet10::Point, double>, 14>& Tet10::gauss() {
+  // Walkington's 14-point rule, degree 5, positive weights (reference volume 1/6): the
+  // 4 + 4 points (a, a, a, 1 - 3a) and the 6 points (b, b, 1/2 - b, 1/2 - b) in barycentric
+  // coordinates.
+  static const std::array<std::pair<Point, double>, 14> rule = [] {
+    std::array<std::pair<Point, double>, 14> r;
+    std::size_t g = 0;
+    auto add = [&](const std::array<double, 4>& L, double w) { r[g++] = {Point(L[1], L[2], L[3]), w}; };
+    for (const auto& [a, w] : {std::pair<double, double>{0.0927352503108912264, 0.01224884051939366},
+                               std::pair<double, double>{0.3108859192633006097, 0.01878132095300264}}) {
+      const double b = 1 - 3 * a;
+      add({b, a, a, a}, w), add({a, b, a, a}, w), add({a, a, b, a}, w), add({a, a, a, b}, w);
+    }
+    const double a = 0.0455037041256496494, b = 0.5 - a, w = 0.007091003462846911;
+    add({a, a, b, b}, w), add({a, b, a, b}, w), add({a, b, b, a}, w);
+    add({b, a, a, b}, w), add({b, a, b, a}, w), add({b, b, a, a}, w);
+    return r;
+  }();
+  return rule;
+}
+
+const std::array<std::array<int, 6>, 4>& Tet10::faces() {
+  // Vertices (a, b, c), then the midpoints of a-b, b-c, c-a (node 4 + edge index).
+  static const std::array<std::array<int, 6>, 4> f = {{{0, 2, 1, 6, 5, 4},  //
+                                                       {0, 1, 3, 4, 9, 7},
+                                                       {1, 2, 3, 5, 8, 9},
+                                                       {0, 3, 2, 7, 8, 6}}};
+  return f;
 }
 
 std::vector<std::array<double, 3>> gauss_rule_2d(int n) {
@@ -364,7 +425,7 @@ bool inverse_map(const typename ElementTraits<Shape>::Coords& X, const typename 
                  typename Shape::Point& xi) {
   using Tensor = typename ElementTraits<Shape>::Tensor;
   using Point = typename Shape::Point;
-  xi.setZero();
+  xi = Shape::centre();
   for (int it = 0; it < 30; ++it) {
     const Point x = X.transpose() * Shape::shape(xi);
     const Tensor Jac = X.transpose() * Shape::derivatives(xi);
@@ -376,10 +437,11 @@ bool inverse_map(const typename ElementTraits<Shape>::Coords& X, const typename 
   return xi.allFinite();  // converged to round-off
 }
 
+#define FSI_SOLID_INSTANTIATE_EAS(Shape)                   \
+  template ElementStateT<Shape> eas_internal_force<Shape>( \
+      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool);
 #define FSI_SOLID_INSTANTIATE(Shape)                                                                                   \
   template ElementStateT<Shape> internal_force<Shape>(                                                                 \
-      const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool); \
-  template ElementStateT<Shape> eas_internal_force<Shape>(                                                             \
       const ElementTraits<Shape>::Coords&, const ElementTraits<Shape>::Vector&, const MaterialLaw<Shape::dim>&, bool); \
   template ElementTraits<Shape>::Matrix element_mass<Shape>(const ElementTraits<Shape>::Coords&, double);              \
   template ElementTraits<Shape>::Vector element_body_force<Shape>(const ElementTraits<Shape>::Coords&,                 \
@@ -389,7 +451,11 @@ bool inverse_map(const typename ElementTraits<Shape>::Coords& X, const typename 
   template bool inverse_map<Shape>(const ElementTraits<Shape>::Coords&, const Shape::Point&, Shape::Point&);
 FSI_SOLID_INSTANTIATE(Quad4)
 FSI_SOLID_INSTANTIATE(Hex8)
+FSI_SOLID_INSTANTIATE(Tet10)
+FSI_SOLID_INSTANTIATE_EAS(Quad4)
+FSI_SOLID_INSTANTIATE_EAS(Hex8)
 #undef FSI_SOLID_INSTANTIATE
+#undef FSI_SOLID_INSTANTIATE_EAS
 
 Eigen::Matrix4d edge_mass(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double weight) {
   const double L = (b - a).norm();
@@ -418,6 +484,54 @@ Eigen::Matrix<double, 4, 3> quad_face_area_vectors(const Eigen::Matrix<double, 4
     out += w * Quad4::shape(xi) * T.col(0).cross(T.col(1)).transpose();
   }
   return out;
+}
+
+namespace {
+void check_face(const Eigen::MatrixXd& X) {
+  if (X.cols() != 3 || (X.rows() != 4 && X.rows() != 6))
+    throw std::invalid_argument("a 3D face needs 4 (quadrilateral) or 6 (quadratic triangle) nodes of 3 coordinates");
+}
+// Calls f(N, tangent_xi x tangent_eta, weight) at the 6-node triangle's quadrature points.
+template <class F>
+void for_triangle_points(const Eigen::MatrixXd& X, F&& f) {
+  Eigen::VectorXd N;
+  Eigen::MatrixX2d dN;
+  for (const auto& q : fsi::face_quadrature(6)) {
+    fsi::face_shape(6, q.xi, q.eta, N, dN);
+    const Eigen::Matrix<double, 3, 2> T = X.transpose() * dN;
+    f(N, Eigen::Vector3d(T.col(0).cross(T.col(1))), q.weight);
+  }
+}
+}  // namespace
+
+Eigen::VectorXd face_weights(const Eigen::MatrixXd& X) {
+  check_face(X);
+  if (X.rows() == 4) return quad_face_weights(X);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(6);
+  for_triangle_points(X,
+                      [&](const Eigen::VectorXd& N, const Eigen::Vector3d& n, double w) { out += w * n.norm() * N; });
+  return out;
+}
+
+Eigen::MatrixXd face_area_vectors(const Eigen::MatrixXd& X) {
+  check_face(X);
+  if (X.rows() == 4) return quad_face_area_vectors(X);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(6, 3);
+  for_triangle_points(
+      X, [&](const Eigen::VectorXd& N, const Eigen::Vector3d& n, double w) { out += w * N * n.transpose(); });
+  return out;
+}
+
+Eigen::VectorXd face_lumped_weights(const Eigen::MatrixXd& X) {
+  check_face(X);
+  if (X.rows() == 4) return quad_face_weights(X);
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(6);
+  double area = 0;
+  for_triangle_points(X, [&](const Eigen::VectorXd& N, const Eigen::Vector3d& n, double w) {
+    diagonal += w * n.norm() * N.cwiseProduct(N);
+    area += w * n.norm();
+  });
+  return area / diagonal.sum() * diagonal;
 }
 
 }  // namespace fsi::solid

@@ -171,14 +171,23 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
   }
   system_ = dim == 2 ? std::make_unique<SolidSystem>(mesh_, material, density, fixed, solver_kind)
                      : std::make_unique<SolidSystem>(mesh_, material3, density, fixed, solver_kind);
-  const auto element = s.get_or<std::string>("element", dim == 2 ? "q4" : "hex8");
-  const std::map<std::string, ElementKind> elements =
-      dim == 2 ? std::map<std::string, ElementKind>{{"q4", ElementKind::Q4}, {"q4_eas", ElementKind::Q4Eas}}
-               : std::map<std::string, ElementKind>{{"hex8", ElementKind::Hex8}, {"h8_eas", ElementKind::Hex8Eas}};
-  if (!elements.count(element))
-    s.fail("element", fmt::format("'{}' is not an element of a {}D mesh (give {})", element, dim,
-                                  dim == 2 ? "q4 or q4_eas" : "hex8 or h8_eas"));
-  system_->set_element(elements.at(element));
+  // The elements of the mesh's cells; the first is the default.
+  const std::vector<std::pair<std::string, ElementKind>> elements =
+      mesh_.cell == CellKind::Quad4
+          ? std::vector<std::pair<std::string, ElementKind>>{{"q4", ElementKind::Q4}, {"q4_eas", ElementKind::Q4Eas}}
+      : mesh_.cell == CellKind::Hex8
+          ? std::vector<std::pair<std::string, ElementKind>>{{"hex8", ElementKind::Hex8},
+                                                             {"h8_eas", ElementKind::Hex8Eas}}
+          : std::vector<std::pair<std::string, ElementKind>>{{"tet10", ElementKind::Tet10}};
+  const auto element = s.get_or<std::string>("element", elements.front().first);
+  const auto chosen = std::find_if(elements.begin(), elements.end(), [&](const auto& e) { return e.first == element; });
+  if (chosen == elements.end()) {
+    std::string names;
+    for (const auto& e : elements) names += (names.empty() ? "" : " or ") + e.first;
+    s.fail("element", fmt::format("'{}' is not an element of a {}D mesh of {} cells (give {})", element, dim,
+                                  cell_kind_name(mesh_.cell), names));
+  }
+  system_->set_element(chosen->second);
 
   // 6. Loads: gravity (force per reference volume rho_s g), dead facet tractions, point loads.
   const Eigen::VectorXd gravity = vec(s, "gravity", dim);
@@ -196,11 +205,12 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
       if (dim == 2) {
         const double L = (mesh_.nodes.row(e[0]) - mesh_.nodes.row(e[1])).norm();
         for (int n : e) dead_load_.segment<2>(2 * n) += 0.5 * L * traction;
-      } else {
-        Eigen::Matrix<double, 4, 3> X;
-        for (int a = 0; a < 4; ++a) X.row(a) = mesh_.nodes.row(e[static_cast<std::size_t>(a)]);
-        const Eigen::Vector4d w = quad_face_weights(X);
-        for (int a = 0; a < 4; ++a) dead_load_.segment<3>(3 * e[static_cast<std::size_t>(a)]) += w(a) * traction;
+      } else {  // int N_a dA, consistent (0 at the vertices of a flat 6-node triangle)
+        Eigen::MatrixXd X(e.size(), 3);
+        for (std::size_t a = 0; a < e.size(); ++a) X.row(static_cast<Eigen::Index>(a)) = mesh_.nodes.row(e[a]);
+        const Eigen::VectorXd w = face_weights(X);
+        for (std::size_t a = 0; a < e.size(); ++a)
+          dead_load_.segment<3>(3 * e[a]) += w(static_cast<Eigen::Index>(a)) * traction;
       }
     }
   }
@@ -257,13 +267,24 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
       interface_.lumped_measure(a) += 0.5 * L;
       interface_.lumped_measure(b) += 0.5 * L;
     }
-  } else {  // the boundary quadrilaterals of the named face sets, bilinear faces of the interface
+  } else {  // the boundary faces of the named sets (bilinear quadrilaterals, or 6-node triangles)
     for (const auto& f : iface_edges) {
       InterfaceFace face;
       for (int v : f) face.nodes.push_back(local[v]);
       interface_.faces.push_back(face);
     }
-    if (!interface_.faces.empty()) interface_.lumped_measure = lumped_interface_measure(interface_);
+    // The row sums of int N^T N (the nodal areas of bilinear faces); those of a 6-node
+    // triangle vanish at its vertices, and the protocol wants every node's measure > 0: the
+    // HRZ shares there (lumped_facet_measure, the same total area).
+    const bool quadratic =
+        std::any_of(iface_edges.begin(), iface_edges.end(), [](const Facet& f) { return f.size() == 6; });
+    if (quadratic) {
+      const Eigen::VectorXd measure = lumped_facet_measure(mesh_, unique_facets(iface_edges));
+      for (std::size_t i = 0; i < interface_nodes_.size(); ++i)
+        interface_.lumped_measure(static_cast<Eigen::Index>(i)) = measure(interface_nodes_[i]);
+    } else if (!interface_.faces.empty()) {
+      interface_.lumped_measure = lumped_interface_measure(interface_);
+    }
   }
   // The solid's mass over its interface measure (the automatic Robin parameter's m_s / |Gamma|):
   // the consistent mass matrix sums to dim rho |Omega_s| (one per component).
@@ -289,21 +310,16 @@ void FemSolid::configure(const ConfigSection& section, const SolidSetup& setup) 
     Probe probe;
     probe.name = p.get<std::string>("name");
     probe.point = vec(p, "point", dim);
-    double best = 1e300;  // the cell whose natural coordinates are closest to [-1, 1]^dim
-    for (int c = 0; c < mesh_.num_cells(); ++c) {
-      Eigen::VectorXd xi;
-      if (dim == 2) {
-        Eigen::Vector2d x2;
-        if (!inverse_map<Quad4>(system_->cell_coordinates<Quad4>(c), probe.point, x2)) continue;
-        xi = x2;
-      } else {
-        Eigen::Vector3d x3;
-        if (!inverse_map<Hex8>(system_->cell_coordinates<Hex8>(c), probe.point, x3)) continue;
-        xi = x3;
+    double best = 1e300;  // the cell whose natural coordinates are the most inside (Shape::extent)
+    with_shape(mesh_.cell, [&](auto shape) {
+      using Shape = decltype(shape);
+      for (int c = 0; c < mesh_.num_cells(); ++c) {
+        typename Shape::Point xi;
+        if (!inverse_map<Shape>(system_->cell_coordinates<Shape>(c), probe.point, xi)) continue;
+        const double outside = Shape::extent(xi);
+        if (outside < best) best = outside, probe.cell = c, probe.xi = xi;
       }
-      const double outside = xi.cwiseAbs().maxCoeff();
-      if (outside < best) best = outside, probe.cell = c, probe.xi = xi;
-    }
+    });
     if (best > 1 + 1e-6) probe.cell = -1;
     if (probe.cell < 0) p.fail("point", "is not inside the solid mesh");
     probes_.push_back(probe);
@@ -556,18 +572,15 @@ SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd
 }
 
 Eigen::VectorXd FemSolid::probe_displacement(const Probe& p, const Eigen::VectorXd& d) const {
-  if (mesh_.dim == 3) {
-    const auto N = Hex8::shape(p.xi);
-    const auto u = system_->cell_values<Hex8>(p.cell, d);
-    Eigen::Vector3d out = Eigen::Vector3d::Zero();
-    for (int a = 0; a < 8; ++a) out += N(a) * u.segment<3>(3 * a);
+  return with_shape(mesh_.cell, [&](auto shape) -> Eigen::VectorXd {
+    using Shape = decltype(shape);
+    constexpr int dim = Shape::dim;
+    const auto N = Shape::shape(p.xi);
+    const auto u = system_->cell_values<Shape>(p.cell, d);
+    Eigen::Matrix<double, dim, 1> out = Eigen::Matrix<double, dim, 1>::Zero();
+    for (int a = 0; a < Shape::nodes; ++a) out += N(a) * u.template segment<dim>(dim * a);
     return out;
-  }
-  const Eigen::Vector4d N = q4_shape(p.xi(0), p.xi(1));
-  const auto u = system_->cell_values(p.cell, d);
-  Eigen::Vector2d out = Eigen::Vector2d::Zero();
-  for (int a = 0; a < 4; ++a) out += N(a) * u.segment<2>(2 * a);
-  return out;
+  });
 }
 
 std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
@@ -705,15 +718,25 @@ std::vector<std::string> FemSolid::write_output(const StepInfo& info) {
   grid.point_data["velocity"] =
       Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(v_n_.data(), nn, dim);
   for (int c = 0; c < nc; ++c) {
-    grid.cells.push_back(mesh_.cells[c]);
-    grid.cell_types.push_back(dim == 2 ? VtkCellType::Quad : VtkCellType::Hexahedron);
+    auto cell = mesh_.cells[c];
+    if (mesh_.cell == CellKind::Tet10) std::swap(cell[8], cell[9]);  // VTK: the midpoints of 1-3, then 2-3
+    grid.cells.push_back(std::move(cell));
+    grid.cell_types.push_back(mesh_.cell == CellKind::Quad4  ? VtkCellType::Quad
+                              : mesh_.cell == CellKind::Hex8 ? VtkCellType::Hexahedron
+                                                             : VtkCellType::QuadraticTetra);
   }
   if (dim == 3) {  // Cauchy stress at the centre: the full 3x3 tensor (row major) and von Mises
     Eigen::MatrixXd tensor(nc, 9);
     Eigen::VectorXd mises(nc);
     for (int c = 0; c < nc; ++c) {
-      const Eigen::Matrix3d F = deformation_gradient<Hex8>(
-          system_->cell_coordinates<Hex8>(c), system_->cell_values<Hex8>(c, d_n_), Eigen::Vector3d::Zero());
+      const Eigen::Matrix3d F = with_shape(mesh_.cell, [&](auto shape) -> Eigen::Matrix3d {
+        using Shape = decltype(shape);
+        if constexpr (Shape::dim == 3)
+          return deformation_gradient<Shape>(system_->cell_coordinates<Shape>(c), system_->cell_values<Shape>(c, d_n_),
+                                             Shape::centre());
+        else
+          return Eigen::Matrix3d::Constant(NAN);
+      });
       const Kinematics3 k = Kinematics3::from_deformation_gradient(F);
       Eigen::Matrix3d sigma = Eigen::Matrix3d::Constant(NAN);
       if (k.J > 0) sigma = from_voigt<3>(cauchy_stress<3>(k, system_->material3().stress(k)));

@@ -7,36 +7,40 @@ namespace fsi::solid {
 const std::vector<schema::Key>& fem_solid_keys() {
   using namespace schema;
   static const std::vector<Key> keys = {
-      section(
-          "mesh", "the solid mesh",
-          {
-              choice("type", {"rectangle", "box", "tube", "gmsh"},
-                     "built-in structured Q4 rectangle (2D), Hex8 box or tube (3D), or a gmsh .msh file (2D)")
-                  .req(),
-              vector("origin", "lower-left (back) corner; tube: the start of its axis (the axis is along +z)")
-                  .req()
-                  .only_when("type", {"rectangle", "box", "tube"})
-                  .in_unit("m"),
-              vector("size", "lx, ly (, lz) (positive)").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
-              int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
-                  .req()
-                  .only_when("type", {"rectangle"}),
-              int_list("divisions", 3,
-                       "box: nx, ny, nz Hex8 cells (>= 1); face sets left, right (x), bottom, top (y), back, front "
-                       "(z). tube: n_theta (>= 3) around, n_r through the wall, n_z along; face sets inner, outer, "
-                       "start (z = origin), end")
-                  .req()
-                  .only_when("type", {"box", "tube"}),
-              number("inner_radius", "tube: inner radius").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
-              number("outer_radius", "tube: outer radius (> inner)")
-                  .req()
-                  .gt(0)
-                  .only_when("type", {"tube"})
-                  .in_unit("m"),
-              number("length", "tube: length along +z").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
-              text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
-              text("domain", "2D physical group of the solid; default: every quad group").only_when("type", {"gmsh"}),
-          })
+      section("mesh", "the solid mesh",
+              {
+                  choice("type", {"rectangle", "box", "tube", "gmsh"},
+                         "built-in structured Q4 rectangle (2D), Hex8 box or tube (3D), or a gmsh .msh file (2D "
+                         "quadrilaterals; 3D "
+                         "10-node tetrahedra or hexahedra)")
+                      .req(),
+                  vector("origin", "lower-left (back) corner; tube: the start of its axis (the axis is along +z)")
+                      .req()
+                      .only_when("type", {"rectangle", "box", "tube"})
+                      .in_unit("m"),
+                  vector("size", "lx, ly (, lz) (positive)").req().only_when("type", {"rectangle", "box"}).in_unit("m"),
+                  int_list("elements", 2, "nx, ny Q4 cells (>= 1); edge sets left, right, bottom, top")
+                      .req()
+                      .only_when("type", {"rectangle"}),
+                  int_list("divisions", 3,
+                           "box: nx, ny, nz Hex8 cells (>= 1); face sets left, right (x), bottom, top (y), back, front "
+                           "(z). tube: n_theta (>= 3) around, n_r through the wall, n_z along; face sets inner, outer, "
+                           "start (z = origin), end")
+                      .req()
+                      .only_when("type", {"box", "tube"}),
+                  number("inner_radius", "tube: inner radius").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
+                  number("outer_radius", "tube: outer radius (> inner)")
+                      .req()
+                      .gt(0)
+                      .only_when("type", {"tube"})
+                      .in_unit("m"),
+                  number("length", "tube: length along +z").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
+                  text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
+                  text("domain",
+                       "physical group of the solid cells (2D: quadrilaterals; 3D: 10-node tetrahedra or 8-node "
+                       "hexahedra); default: every group of the mesh's dimension")
+                      .only_when("type", {"gmsh"}),
+              })
           .req(),
       section("material", "hyperelastic material (plane strain in 2D); exactly one of youngs_modulus, shear_modulus",
               {
@@ -46,10 +50,11 @@ const std::vector<schema::Key>& fem_solid_keys() {
                   number("shear_modulus", "mu").gt(0).group("modulus").in_unit("Pa"),
               })
           .req(),
-      choice("element", {"q4", "q4_eas", "hex8", "h8_eas"},
+      choice("element", {"q4", "q4_eas", "hex8", "h8_eas", "tet10"},
              "2D: bilinear Q4, or Q4 with enhanced assumed strains (no shear locking in bending; same nodes); "
-             "3D: trilinear Hex8, or Hex8 with 9 enhanced strain modes")
-          .def_computed("q4 (2D), hex8 (3D)"),
+             "3D hexahedra: trilinear Hex8, or Hex8 with 9 enhanced strain modes; 3D tetrahedra (gmsh): the "
+             "quadratic Tet10")
+          .def_computed("q4 (2D), hex8 (hexahedra), tet10 (tetrahedra)"),
       number("density", "rho_s, reference configuration").req().gt(0).in_unit("kg/m^3"),
       vector("gravity", "body force per unit mass").def_computed("0 (every component)").in_unit("m/s^2"),
       choice("analysis", {"static", "dynamic"}, "equilibrium every step, or dynamics").def("dynamic"),

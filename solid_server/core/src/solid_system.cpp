@@ -48,14 +48,6 @@ Eigen::VectorXd SparseDirectSolver::solve(const Eigen::VectorXd& b) const {
 }
 
 // ---------------------------------------------------------------- system
-namespace {
-// Calls f(Quad4{}) on a 2D mesh and f(Hex8{}) on a 3D one: the loops below are written once.
-template <class F>
-decltype(auto) with_shape(int dim, F&& f) {
-  if (dim == 3) return f(Hex8{});
-  return f(Quad4{});
-}
-}  // namespace
 
 InvertedElement::InvertedElement(int e, double det)
     : std::runtime_error("element " + std::to_string(e) + ": det F = " + std::to_string(det) + " <= 0"),
@@ -73,20 +65,27 @@ SolidSystem::SolidSystem(const SolidMesh& mesh, std::shared_ptr<const Material3>
                          std::vector<char> fixed_dofs, LinearSolverKind solver)
     : mesh_(mesh), material3_(std::move(material)), density_(density), fixed_(std::move(fixed_dofs)), solver_(solver) {
   if (mesh_.dim != 3) throw std::invalid_argument("SolidSystem: a 3D material law needs a 3D mesh");
-  element_ = ElementKind::Hex8;
+  if (mesh_.cell == CellKind::Quad4)
+    throw std::invalid_argument("SolidSystem: a 3D mesh needs Hex8 or Tet10 cells (SolidMesh::cell)");
+  element_ = mesh_.cell == CellKind::Tet10 ? ElementKind::Tet10 : ElementKind::Hex8;
   initialise();
 }
 
 void SolidSystem::set_element(ElementKind kind) {
-  const bool three_d = kind == ElementKind::Hex8 || kind == ElementKind::Hex8Eas;
-  if (three_d != (mesh_.dim == 3))
-    throw std::invalid_argument(std::string("SolidSystem: ") + (three_d ? "a hexahedron" : "a quadrilateral") +
-                                " element on a " + std::to_string(mesh_.dim) + "D mesh");
+  const CellKind cell = kind == ElementKind::Tet10                                  ? CellKind::Tet10
+                        : kind == ElementKind::Hex8 || kind == ElementKind::Hex8Eas ? CellKind::Hex8
+                                                                                    : CellKind::Quad4;
+  if (cell != mesh_.cell)
+    throw std::invalid_argument(std::string("SolidSystem: a ") + cell_kind_name(cell) + " element on a mesh of " +
+                                cell_kind_name(mesh_.cell) + " cells");
   element_ = kind;
 }
 
 void SolidSystem::initialise() {
   const int n = num_dofs();
+  if ((mesh_.dim == 2) != (mesh_.cell == CellKind::Quad4))
+    throw std::invalid_argument(std::string("SolidSystem: a ") + std::to_string(mesh_.dim) + "D mesh of " +
+                                cell_kind_name(mesh_.cell) + " cells");
   if (mesh_.nodes.cols() != mesh_.dim)
     throw std::invalid_argument("SolidSystem: the mesh's nodes need " + std::to_string(mesh_.dim) + " coordinates");
   if (static_cast<int>(fixed_.size()) != n)
@@ -110,10 +109,13 @@ void SolidSystem::initialise() {
       if (!(area2 > 0))
         throw std::invalid_argument("cell " + std::to_string(c) + " is not counter-clockwise or is degenerate");
     } else {
-      const auto X = cell_coordinates<Hex8>(c);
-      for (const auto& [xi, w] : Hex8::gauss())
-        if (!((X.transpose() * Hex8::derivatives(xi)).determinant() > 0))
-          throw std::invalid_argument("cell " + std::to_string(c) + " is inverted or degenerate (node order)");
+      with_shape(mesh_.cell, [&](auto shape) {
+        using Shape = decltype(shape);
+        const auto X = cell_coordinates<Shape>(c);
+        for (const auto& [xi, w] : Shape::gauss())
+          if (!((X.transpose() * Shape::derivatives(xi)).determinant() > 0))
+            throw std::invalid_argument("cell " + std::to_string(c) + " is inverted or degenerate (node order)");
+      });
     }
   }
 
@@ -161,7 +163,7 @@ void SolidSystem::build_pattern(const std::vector<Eigen::Triplet<double>>& extra
     }
 
   mass_ = pattern_;
-  with_shape(dim, [&](auto shape) {
+  with_shape(mesh_.cell, [&](auto shape) {
     using Shape = decltype(shape);
     for (int c = 0; c < mesh_.num_cells(); ++c) {
       const auto Me = element_mass<Shape>(cell_coordinates<Shape>(c), density_);
@@ -224,7 +226,7 @@ void SolidSystem::set_damping(SparseMatrix damping) {
 Eigen::VectorXd SolidSystem::body_force(const Eigen::VectorXd& b) const {
   if (b.size() != mesh_.dim) throw std::invalid_argument("body_force: one component per dimension");
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
-  with_shape(mesh_.dim, [&](auto shape) {
+  with_shape(mesh_.cell, [&](auto shape) {
     using Shape = decltype(shape);
     constexpr int dim = Shape::dim;
     const Eigen::Matrix<double, dim, 1> bd = b;
@@ -262,14 +264,15 @@ ElementStateT<Shape> SolidSystem::cell_state(int c, const Eigen::VectorXd& d, bo
     else
       return *material3_;
   }();
-  if (is_enhanced(element_))
-    return eas_internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
+  if constexpr (Shape::eas_modes > 0)
+    if (is_enhanced(element_))
+      return eas_internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
   return solid::internal_force<Shape>(cell_coordinates<Shape>(c), cell_values<Shape>(c, d), law, with_tangent);
 }
 
 Eigen::VectorXd SolidSystem::internal_force(const Eigen::VectorXd& d) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(num_dofs());
-  with_shape(mesh_.dim, [&](auto shape) {
+  with_shape(mesh_.cell, [&](auto shape) {
     using Shape = decltype(shape);
     constexpr int dim = Shape::dim;
     for (int c = 0; c < mesh_.num_cells(); ++c) {
@@ -308,7 +311,7 @@ void SolidSystem::assemble(const Eigen::VectorXd& d, const Eigen::VectorXd& f_ex
   std::fill(K.valuePtr(), K.valuePtr() + K.nonZeros(), 0.0);
   Eigen::VectorXd r = -f_ext;
   double* values = K.valuePtr();
-  with_shape(mesh_.dim, [&](auto shape) {
+  with_shape(mesh_.cell, [&](auto shape) {
     using Shape = decltype(shape);
     constexpr int dim = Shape::dim, nd = ElementTraits<Shape>::dofs;
     for (int c = 0; c < mesh_.num_cells(); ++c) {

@@ -15,16 +15,16 @@ namespace fsi {
 
 struct GmshGroup {
   std::string name;   // physical name ("" if unnamed; then "tag<N>")
-  int dimension = 0;  // 1 = lines, 2 = surface cells, 3 = tetrahedra
+  int dimension = 0;  // 1 = lines, 2 = surface cells, 3 = tetrahedra or hexahedra
   int physical_tag = 0;
-  int element_type = 0;  // gmsh type: 1 line2, 2 tri3, 3 quad4, 4 tet4, 8 line3, 9 tri6, 10 quad9, 11 tet10
+  int element_type = 0;  // gmsh type: 1 line2, 2 tri3, 3 quad4, 4 tet4, 5 hex8, 8 line3, 9 tri6, 10 quad9, 11 tet10
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> elements;  // 0-based node indices
 };
 
 struct GmshMesh {
   Eigen::MatrixX2d nodes;   // x, y of every node (0-based index)
   Eigen::VectorXd z;        // z of every node (0 in a planar mesh)
-  bool has_volume() const;  // a group of tetrahedra (a 3D mesh)
+  bool has_volume() const;  // a group of tetrahedra or hexahedra (a 3D mesh)
   std::vector<GmshGroup> groups;
   const GmshGroup& group(const std::string& name) const;  // throws listing known names
   bool has_group(const std::string& name) const;

@@ -104,8 +104,13 @@ class ObstacleContact {
   std::vector<int> excluded_;             // per obstacle
 };
 
-// The lumped measure of each node of the facets (2D: half of each edge; 3D: the bilinear
-// faces' int N_a dA), size = number of mesh nodes.
-Eigen::VectorXd lumped_facet_measure(const SolidMesh& mesh, const std::vector<Facet>& facets);
+// The lumped measure of each node of the facets, size = number of mesh nodes. 2D: half of
+// each edge; 3D bilinear quadrilaterals: int N_a dA. 6-node triangles: `Positive` (contact:
+// every node needs a share) the HRZ shares of face_lumped_weights; `RowSum` (elastic supports:
+// a uniform displacement then meets the same nodal distribution as a uniform traction) the
+// consistent int N_a dA, 0 at the vertices of a flat face.
+enum class FacetLumping { Positive, RowSum };
+Eigen::VectorXd lumped_facet_measure(const SolidMesh& mesh, const std::vector<Facet>& facets,
+                                     FacetLumping lumping = FacetLumping::Positive);
 
 }  // namespace fsi::solid

@@ -1,6 +1,6 @@
 #pragma once
 // FemSolid: the finite-strain solid as an fsi::SolidModel, in 2D (plane strain Q4) or 3D
-// (Hex8), the dimension taken from its mesh.
+// (Hex8 or Tet10), the dimension and cell kind taken from its mesh.
 //
 // Call order (the contract of solver_model.hpp):
 //   configure(section, setup) -> interface() -> { solve_step(info, F) ... accept_step(info) } -> write_output(info)

@@ -1,12 +1,14 @@
 #pragma once
-// Solid meshes of either dimension: Q4 cells in 2D, Hex8 cells in 3D, and named facet sets
-// (boundary edges in 2D, boundary quadrilaterals in 3D) for clamps, supports, interfaces
-// and loads.
+// Solid meshes of either dimension: Q4 cells in 2D, Hex8 or Tet10 cells in 3D, and named
+// facet sets (boundary edges in 2D; boundary quadrilaterals of Hex8 meshes or 6-node
+// triangles of Tet10 meshes in 3D) for clamps, supports, interfaces and loads.
 #include <Eigen/Core>
 #include <array>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "fsi/solid/element.hpp"
 
 namespace fsi {
 struct GmshMesh;
@@ -14,23 +16,39 @@ struct GmshMesh;
 
 namespace fsi::solid {
 
-using Facet = std::vector<int>;  // 2 nodes (2D edge) or 4 nodes (3D quadrilateral face)
+// 2 nodes (2D edge), 4 nodes (3D quadrilateral face of a Hex8 mesh) or 6 nodes (3D quadratic
+// triangle of a Tet10 mesh, gmsh order: vertices, then the midpoints of 0-1, 1-2, 2-0)
+using Facet = std::vector<int>;
+
+// The cells' shape (element.hpp); every cell of a mesh has the same.
+enum class CellKind { Quad4, Hex8, Tet10 };
+const char* cell_kind_name(CellKind kind);  // "quadrilateral (Q4)", ...
 
 struct SolidMesh {
-  int dim = 2;                                           // 2: plane strain Q4; 3: Hex8
+  int dim = 2;                                           // 2: plane strain Q4; 3: Hex8 or Tet10
+  CellKind cell = CellKind::Quad4;                       // Quad4 in 2D; Hex8 or Tet10 in 3D
   Eigen::MatrixXd nodes;                                 // reference coordinates, n x dim
-  std::vector<std::vector<int>> cells;                   // counter-clockwise Q4, or Hex8 (element.hpp's order)
+  std::vector<std::vector<int>> cells;                   // counter-clockwise Q4, or Hex8 / Tet10 (element.hpp's order)
   std::map<std::string, std::vector<Facet>> facet_sets;  // boundary facets by name
 
   int num_nodes() const { return static_cast<int>(nodes.rows()); }
   int num_cells() const { return static_cast<int>(cells.size()); }
-  int nodes_per_cell() const { return dim == 2 ? 4 : 8; }
+  int nodes_per_cell() const { return cell == CellKind::Quad4 ? 4 : cell == CellKind::Hex8 ? 8 : 10; }
   // Facets of the named sets (throws std::invalid_argument listing the known names).
   std::vector<Facet> facets(const std::vector<std::string>& names) const;
   // Unique node ids of the named sets, in order of first appearance.
   std::vector<int> facet_nodes(const std::vector<std::string>& names) const;
   std::vector<std::string> facet_set_names() const;
 };
+
+// Calls f(Quad4{}), f(Hex8{}) or f(Tet10{}) by the mesh's cell kind: loops over cells are
+// written once, templated on the shape.
+template <class F>
+decltype(auto) with_shape(CellKind kind, F&& f) {
+  if (kind == CellKind::Tet10) return f(Tet10{});
+  if (kind == CellKind::Hex8) return f(Hex8{});
+  return f(Quad4{});
+}
 
 // The facets without repeats (a facet in two named sets, or listed twice, counted once), in
 // order of first appearance.
@@ -59,14 +77,23 @@ SolidMesh box_mesh(const Eigen::Vector3d& origin, const Eigen::Vector3d& size, i
 SolidMesh tube_mesh(const Eigen::Vector3d& origin, double r_inner, double r_outer, double length, int n_theta, int n_r,
                     int n_z);
 
+// The box of box_mesh() with each of its nx x ny x nz cubes split into 6 Tet10 cells around
+// its diagonal (Kuhn; conforming), straight edges; the same six face sets as 6-node
+// triangles, right-handed outward. The vertices come first, numbered as box_mesh's nodes.
+SolidMesh box_tet_mesh(const Eigen::Vector3d& origin, const Eigen::Vector3d& size, int nx, int ny, int nz);
+
 // Moves interior nodes of a mesh by a smooth-free random-like but deterministic
 // perturbation of up to `fraction` of the local spacing (for patch tests).
 void distort_interior(SolidMesh& mesh, double fraction, unsigned seed = 1);
 
-// Converts a gmsh mesh (2D): every 2D group of quad4 cells (or only `domain` when non-empty)
-// becomes the cells, every 1D group of 2-node lines an edge set of the same name. Unused
-// nodes are dropped; clockwise cells are reordered. Throws std::invalid_argument on
-// unsupported cell types.
+// Converts a gmsh mesh. 2D: every 2D group of quad4 cells (or only `domain` when non-empty)
+// becomes the cells, every 1D group of 2-node lines an edge set of the same name; clockwise
+// cells are reordered. 3D (a mesh with volume groups): every 3D group (or only `domain`) of
+// 10-node tetrahedra (gmsh type 11) or of 8-node hexahedra (type 5) becomes the cells, every
+// 2D group of 6-node triangles (type 9) or 4-node quadrilaterals (type 3) respectively a face
+// set; tetrahedra of negative orientation are mirrored. Unused nodes are dropped. Throws
+// std::invalid_argument naming the group (and cell) for unsupported types, a facet that is no
+// cell's side, or a cell whose map has det J <= 0 at a Gauss point.
 SolidMesh mesh_from_gmsh(const GmshMesh& gmsh, const std::string& domain = "");
 
 }  // namespace fsi::solid

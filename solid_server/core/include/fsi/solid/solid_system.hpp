@@ -7,8 +7,8 @@
 //
 // Usage:
 //   SolidSystem sys(mesh, material, density, fixed);   // fixed: one flag per dof
-// One code for 2D (Q4, plane strain) and 3D (Hex8): the mesh's dimension picks the element
-// shape, and the 3D constructor takes the 3D material law.
+// One code for 2D (Q4, plane strain) and 3D (Hex8, Tet10): the mesh's cell kind picks the
+// element shape, and the 3D constructor takes the 3D material law.
 //   sys.set_damping(sys.boundary_mass(edges, gamma));   // optional (Algorithm 2)
 //   NewtonReport r = sys.solve(d, f_ext, terms, options);
 // The sparsity pattern is analysed once (first solve); each Newton iteration
@@ -97,8 +97,9 @@ class SolidSystem {
   const std::vector<char>& fixed() const { return fixed_; }
 
   const SparseMatrix& mass() const { return mass_; }  // full, consistent
-  // Q4 (2D default) or Q4 with enhanced assumed strains, for every cell; Hex8 (3D default) or
-  // Hex8 with enhanced assumed strains. Throws std::invalid_argument for the other dimension's.
+  // Q4 (2D default) or Q4 with enhanced assumed strains, for every cell; Hex8 (default on
+  // hexahedra) or Hex8 with enhanced assumed strains; Tet10 on tetrahedra. Throws
+  // std::invalid_argument for an element of another cell kind.
   void set_element(ElementKind kind);
   ElementKind element() const { return element_; }
   // weight * int N^T N ds on the given edges (reference configuration), full size (2D).
@@ -141,7 +142,7 @@ class SolidSystem {
   SparseDirectSolver& linear_solver() { return solver_; }
   int equation(int dof) const { return equation_[dof]; }
 
-  // A cell's reference coordinates and displacement dofs (Shape: Quad4 on 2D meshes, Hex8 on 3D).
+  // A cell's reference coordinates and displacement dofs (Shape: the mesh's, see with_shape).
   template <class Shape = Quad4>
   typename ElementTraits<Shape>::Coords cell_coordinates(int cell) const {
     typename ElementTraits<Shape>::Coords X;
