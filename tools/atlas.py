@@ -10,6 +10,9 @@ The atlas studies (studies/atlas_*.yaml), each into OUT/NAME:
   added_mass   the added-mass model over the mass ratio, against the converged (monolithic) solution
   thick_beam   the paper's thick beam, t in [0, 2], against its converged run (IQN-ILS to 1e-10)
   thin_beam    the paper's thin beam, t in [0, 0.5], against its converged run
+  fsi3         a short Turek-Hron FSI3 window forked from a developed state, against its converged run
+  time_thin_beam  the thin beam's time step, the solid subcycled and Robin-Neumann, against a fine-dt run
+  time_fsi3    the FSI3 window with 1, 2, 4 solid substeps per fluid step, against 8
 """
 import argparse
 import csv
@@ -21,16 +24,19 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1]
 STUDY = SRC / "studies" / "atlas_added_mass.yaml"
-ATLAS = {name: SRC / "studies" / f"atlas_{name}.yaml" for name in ("added_mass", "thick_beam", "thin_beam", "fsi3")}
+ATLAS = {name: SRC / "studies" / f"atlas_{name}.yaml"
+         for name in ("added_mass", "thick_beam", "thin_beam", "fsi3", "time_thin_beam", "time_fsi3")}
 # Studies that fork from a developed state: the run that develops it (into OUT/NAME_developed).
 DEVELOP = {"fsi3": ["configs/fsi3.yaml", "--set", "time.end=2.2525", "--set", "time.checkpoint_every=900",
                     "--set", "fluid.mesh.size=0.04", "--set", "fluid.mesh.parameters={hc: 0.006, hw: 0.016}"]}
+DEVELOPED_BY = {"time_fsi3": "fsi3"}  # studies forking from another study's developed state
 CONVERGED_ERROR = 1e-6  # a run this close to the converged solution counts as converged
 CONVERGED_REF_ERROR = 1e-4  # the same against a converged reference run (iterated to 1e-6, the reference to 1e-10)
 
 
 def develop(name, out, fsi):
     """The developed state a forked study starts from: run once (from rest), reused after."""
+    name = DEVELOPED_BY.get(name, name)
     d = Path(out).parent / f"{name}_developed"
     if (d / "checkpoints").is_dir() and any((d / "checkpoints").iterdir()):
         return d
@@ -45,7 +51,7 @@ def run_study(study, out, jobs, fsi, name=""):
            "--jobs", str(jobs), "--quiet"]
     if fsi:
         cmd += ["--fsi", fsi]
-    if name in DEVELOP:
+    if DEVELOPED_BY.get(name, name) in DEVELOP:
         cmd += ["--from", str(develop(name, out, fsi))]
     subprocess.run(cmd, check=True)
 
@@ -272,6 +278,80 @@ def section_reference(name, out, page, study):
     return lines
 
 
+TIME_TITLES = {
+    "time_thin_beam": ("The thin beam: time step, subcycling, Robin-Neumann", "configs/thin_beam.yaml", [
+        "The thin beam up to t = 0.5 (BDF1 fluid and solid), every run against the converged run at",
+        "dt 0.00125 (at dt 0.000625 the mesh motion tangles at t = 0.26): the error is the time",
+        "discretisation's plus the scheme's. Rows: both solvers at a",
+        "smaller dt; coupling windows of 0.005 and 0.0025 with the solid subcycled (`solid.substeps`,",
+        "waveform iterations, IQN-ILS on the whole window); the explicit Robin-Neumann scheme."]),
+    "time_fsi3": ("Turek-Hron FSI3: the solid subcycled", "configs/fsi3.yaml", [
+        "The FSI3 window above (forked at t = 2.25, up to t = 2.75; coupling window = the fluid's step",
+        "0.0025), converged, with 1, 2 and 4 solid substeps per window, against the same window with 8",
+        "solid substeps iterated to 1e-8. A fork keeps dt, so the fluid's step is not refined here: the",
+        "errors are what the solid's own time step adds at this fluid step."]),
+}
+TIME_DT = {"time_fsi3": "0.0025"}  # the window of a study whose rows do not set time.dt (a fork keeps the scene's)
+
+
+def plot_time(rows, png, title):
+    """Error against wall time, one line per series (dt refined, solid subcycled, ...)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    pts = [r for r in rows if r["outcome"] == "completed" and not r["name"].startswith("reference")
+           and math.isfinite(r["_err"]) and math.isfinite(r["_wall"]) and r["_wall"] > 0]
+    if not pts:
+        return False
+    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    markers = "osD^v<>phX*"
+    series = []
+    for r in pts:
+        if r.get("series", "") not in series:
+            series.append(r.get("series", ""))
+    for i, s in enumerate(series):
+        line = sorted((r for r in pts if r.get("series", "") == s), key=lambda r: r["_wall"])
+        ax.plot([r["_wall"] for r in line], [max(r["_err"], 1e-12) for r in line], marker=markers[i % len(markers)],
+                label=s or "runs")
+        for r in line:
+            ax.annotate(r["scheme"].split(" solid ")[-1] if " solid " in r["scheme"] else r["scheme"].split()[-1],
+                        (r["_wall"], max(r["_err"], 1e-12)), fontsize=6, xytext=(3, 3), textcoords="offset points")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time of the run (s)")
+    ax.set_ylabel("rel. L2 error of A_x against the reference run")
+    ax.set_title(title)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def section_time(name, out, page, study):
+    """A time-resolution study: each row's window, substeps, cost and error against a finer run."""
+    rows = read_reference_rows(out, "solid.A_x")
+    page = Path(page)
+    title, scene, text = TIME_TITLES[name]
+    png = page.parent / "img" / f"atlas_{name}.png"
+    drawn = plot_time(rows, png, f"{title}: error against wall time")
+    rel = Path(study).relative_to(SRC) if Path(study).is_relative_to(SRC) else study
+    lines = [f"## {title} (`{scene}`, `{rel}`)", "", *text,
+             "Wall times: one run at a time with one core for it (`--jobs 1` beside another job).", "",
+             f"![error against wall time]({png.relative_to(page.parent)})" if drawn else
+             "(No plot: no run has an error against a completed reference.)", "",
+             "| run | window dt | solid substeps | outcome | iterations / window | wall s | rel. L2 error A_x | rel. L2 error A_y |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        done = r["outcome"] == "completed"
+        outcome = r["outcome"] if done else f"{r['outcome']} ({r.get('reason_kind', '')})"
+        lines.append(f"| {r['scheme']} | {r.get('time.dt') or TIME_DT.get(name, '-')} | {r.get('solid.substeps') or '-'} | {outcome} | "
+                     f"{fmt(r['_its'])} | {fmt(r['_wall'])} | {fmt(r['_err']) if done else '-'} | "
+                     f"{fmt(number(r, 'solid.A_y.l2_rel')) if done else '-'} |")
+    return lines + [""]
+
+
 DECISION = """## Which scheme for my case
 
 Place your case on the m_a / m axis first: m_a is the fluid mass the interface drags along, m
@@ -317,6 +397,8 @@ def write_page(sections, page, command):
             header = f.readline().split(",")
         if "fluid.added_mass" in header:  # the model problem, over the mass ratio
             lines += section_added_mass(out, page, study)
+        elif name in TIME_TITLES:
+            lines += section_time(name, out, page, study)
         else:
             lines += section_reference(name, out, page, study)
     lines += ["## Not in the atlas yet", ""]
