@@ -204,6 +204,22 @@ def read_reference_rows(out, probe):
     return rows
 
 
+def save_error_wall(fig, ax, png, title, ylabel):
+    """Finishes an error-against-wall-time plot (log-log) and writes it to png."""
+    import matplotlib.pyplot as plt
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time of the run (s)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return True
+
+
 def plot_work_precision(rows, png, title):
     import matplotlib
     matplotlib.use("Agg")
@@ -217,17 +233,7 @@ def plot_work_precision(rows, png, title):
     for i, r in enumerate(pts):
         ax.plot([r["_wall"]], [max(r["_err"], 1e-12)], marker=markers[i % len(markers)], linestyle="",
                 label=f"{r['scheme']} ({fmt(r['_its'])} it/step)")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall time of the run (s)")
-    ax.set_ylabel("rel. L2 error of A_x against the converged run (floor 1e-12)")
-    ax.set_title(title)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    png.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
-    return True
+    return save_error_wall(fig, ax, png, title, "rel. L2 error of A_x against the converged run (floor 1e-12)")
 
 
 def section_reference(name, out, page, study):
@@ -316,17 +322,7 @@ def plot_time(rows, png, title):
         for r in line:
             ax.annotate(r["scheme"].split(" solid ")[-1] if " solid " in r["scheme"] else r["scheme"].split()[-1],
                         (r["_wall"], max(r["_err"], 1e-12)), fontsize=6, xytext=(3, 3), textcoords="offset points")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall time of the run (s)")
-    ax.set_ylabel("rel. L2 error of A_x against the reference run")
-    ax.set_title(title)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    png.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
-    return True
+    return save_error_wall(fig, ax, png, title, "rel. L2 error of A_x against the reference run")
 
 
 def section_time(name, out, page, study):
