@@ -7,15 +7,12 @@
 #include <fstream>
 
 #include "fsi/solid/fem_solid.hpp"
+#include "source_files.hpp"
 
 using namespace fsi::solid;
+using fsi::solid::test::repo_root;
 
 namespace {
-
-std::filesystem::path repo_root() {
-  // tests run from the build tree; the source tree is found from this file's path.
-  return std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
-}
 
 struct Run {
   std::map<std::string, double> probes;

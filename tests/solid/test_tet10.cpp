@@ -15,19 +15,13 @@
 
 #include "fsi/common/gmsh_reader.hpp"
 #include "fsi/solid/fem_solid.hpp"
+#include "source_files.hpp"
 
 using namespace fsi::solid;
+using fsi::solid::test::read_text;
+using fsi::solid::test::repo_root;
 
 namespace {
-
-std::filesystem::path repo_root() { return std::filesystem::path(__FILE__).parent_path().parent_path().parent_path(); }
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 using Coords = ElementTraits<Tet10>::Coords;
 using Vector = ElementTraits<Tet10>::Vector;
