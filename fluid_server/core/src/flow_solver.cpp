@@ -166,15 +166,129 @@ std::unique_ptr<detail::FlowElementT<3>> make_element(const std::string& name, T
   throw std::invalid_argument("3D fluid element must be p2p1 (Taylor-Hood on tetrahedra), got '" + name + "'");
 }
 
+// The volume terms' assembly: every cell's unknowns and their positions in the matrix's values
+// (the pattern), and the loop over a range of cells (threads: each its own copy of the values,
+// summed in thread order).
+template <int Dim>
+struct CellAssembly {
+  const detail::FlowElementT<Dim>* element = nullptr;
+  int local = 0;                  // unknowns per cell
+  int dofs = 0;                   // unknowns in all
+  std::vector<int> element_dofs;  // per cell its `local` unknowns
+  std::vector<int> scatter;       // per cell local x local positions in valuePtr (column-major local)
+  std::size_t nonzeros = 0;
+  std::vector<std::vector<double>> thread_values;
+
+  const int* dofs_of(int e) const {
+    return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)];
+  }
+  const int* scatter_of(int e) const {
+    return &scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local)];
+  }
+  // Adds a local system of cell e to the matrix values and the right-hand side.
+  void add(int e, const detail::LocalSystem& s, double* values, Eigen::VectorXd& b) const {
+    const int* sc = scatter_of(e);
+    for (int j = 0; j < local; ++j)
+      for (int i = 0; i < local; ++i) values[sc[local * j + i]] += s.matrix(i, j);
+    const int* d = dofs_of(e);
+    for (int i = 0; i < local; ++i) b(d[i]) += s.rhs(i);
+  }
+
+  // Sparsity: per column the sorted rows coupled to it by some cell; returns the CSC structure
+  // (values 0) and keeps every cell's positions in it.
+  Eigen::SparseMatrix<double> build(const detail::FlowElementT<Dim>& e, int unknowns) {
+    element = &e;
+    dofs = unknowns;
+    const int ndof = dofs, ne = e.mesh().cell_count();
+    local = e.local_size();
+    element_dofs.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local));
+    for (int c = 0; c < ne; ++c) e.element_dofs(c, &element_dofs[static_cast<std::size_t>(c * local)]);
+    std::vector<std::vector<int>> rows(static_cast<std::size_t>(ndof));
+    for (int c = 0; c < ne; ++c)
+      for (int i = 0; i < local; ++i)
+        for (int j = 0; j < local; ++j) rows[static_cast<std::size_t>(dofs_of(c)[i])].push_back(dofs_of(c)[j]);
+    std::size_t nnz = 0;
+    for (auto& list : rows) {
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
+      nnz += list.size();
+    }
+    Eigen::SparseMatrix<double> matrix(ndof, ndof);
+    matrix.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+    int pos = 0;
+    for (int c = 0; c < ndof; ++c) {
+      matrix.outerIndexPtr()[c] = pos;
+      for (int r : rows[static_cast<std::size_t>(c)]) matrix.innerIndexPtr()[pos++] = r;
+    }
+    matrix.outerIndexPtr()[ndof] = pos;
+    std::fill(matrix.valuePtr(), matrix.valuePtr() + nnz, 0.0);
+    nonzeros = nnz;
+    scatter.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local * local));
+    for (int c = 0; c < ne; ++c) {
+      const int* d = dofs_of(c);
+      for (int j = 0; j < local; ++j) {
+        const auto& list = rows[static_cast<std::size_t>(d[j])];
+        for (int i = 0; i < local; ++i) {
+          const auto it = std::lower_bound(list.begin(), list.end(), d[i]);
+          scatter[static_cast<std::size_t>(c) * static_cast<std::size_t>(local * local) +
+                  static_cast<std::size_t>(local * j + i)] =
+              matrix.outerIndexPtr()[d[j]] + static_cast<int>(it - list.begin());
+        }
+      }
+    }
+    return matrix;
+  }
+
+  // The cells [first, last) into `values` (nonzeros) and `b` (dofs), both overwritten. Returns
+  // an inverted cell (with its `bad` measure), or -1.
+  int assemble(const detail::AssemblyInputT<Dim>& in, int first, int last, int nthreads, double* values,
+               Eigen::VectorXd& b, double& bad) {
+    thread_values.resize(static_cast<std::size_t>(nthreads));
+    std::vector<Eigen::VectorXd> thread_rhs(static_cast<std::size_t>(nthreads), Eigen::VectorXd::Zero(dofs));
+    int bad_element = -1;
+#pragma omp parallel num_threads(nthreads)
+    {
+#ifdef _OPENMP
+      const int tid = omp_get_thread_num();
+#else
+      const int tid = 0;
+#endif
+      auto& mine = thread_values[static_cast<std::size_t>(tid)];
+      mine.assign(nonzeros, 0.0);
+      auto& rhs = thread_rhs[static_cast<std::size_t>(tid)];
+      detail::LocalSystem s;
+#pragma omp for schedule(static)
+      for (int e = first; e < last; ++e) {
+        double measure = 0;
+        if (!element->assemble(e, in, s, measure)) {
+#pragma omp critical
+          {
+            bad_element = e;
+            bad = measure;
+          }
+          continue;
+        }
+        add(e, s, mine.data(), rhs);
+      }
+    }
+    std::copy(thread_values[0].begin(), thread_values[0].end(), values);
+    b = thread_rhs[0];
+    for (int t = 1; t < nthreads; ++t) {
+      const auto& tv = thread_values[static_cast<std::size_t>(t)];
+      for (std::size_t k = 0; k < nonzeros; ++k) values[k] += tv[k];
+      b += thread_rhs[static_cast<std::size_t>(t)];
+    }
+    return bad_element;
+  }
+};
+
 }  // namespace
 
 template <int Dim>
 struct BasicFlowSolver<Dim>::Impl {
   std::unique_ptr<detail::FlowElementT<Dim>> element;
   detail::DofLayout dof;
-  int local = 0;                               // unknowns per triangle
-  std::vector<int> element_dofs;               // per triangle its `local` unknowns
-  std::vector<int> scatter;                    // per triangle local x local positions in valuePtr (column-major local)
+  CellAssembly<Dim> cells;                     // the pattern and the volume loop
   Eigen::SparseMatrix<double> matrix, volume;  // the system (constraints applied); the volume terms (reactions)
   Eigen::VectorXd rhs, rhs_volume;
   std::unique_ptr<LinearSolver> lu;
@@ -189,117 +303,24 @@ struct BasicFlowSolver<Dim>::Impl {
   int pressure_vertex = -1;
   std::function<double(double)> pressure_value;
   Velocity body_force;
-  std::vector<std::vector<double>> thread_values;
 
   const Mesh& mesh() const { return element->mesh(); }
   std::vector<detail::InterfaceEdge> traces(const std::vector<std::string>& groups, const std::map<int, int>& index,
                                             std::vector<std::array<int, 2>>& segments,
                                             std::vector<std::array<int, 6>>& faces) const;
-  const int* dofs_of(int e) const {
-    return &element_dofs[static_cast<std::size_t>(e) * static_cast<std::size_t>(local)];
-  }
-  const int* scatter_of(int e) const {
-    return &scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local)];
-  }
-  // Adds a local system of triangle e to the matrix values and the right-hand side.
+  const int* dofs_of(int e) const { return cells.dofs_of(e); }
   void add(int e, const detail::LocalSystem& s, double* values, Eigen::VectorXd& b) const {
-    const int* sc = scatter_of(e);
-    for (int j = 0; j < local; ++j)
-      for (int i = 0; i < local; ++i) values[sc[local * j + i]] += s.matrix(i, j);
-    const int* d = dofs_of(e);
-    for (int i = 0; i < local; ++i) b(d[i]) += s.rhs(i);
+    cells.add(e, s, values, b);
   }
-  void build_pattern();
-  int assemble_volume(const detail::AssemblyInputT<Dim>& in, int threads, double& bad);
+  void build_pattern() {
+    matrix = cells.build(*element, dof.dofs);
+    volume = matrix;
+  }
+  // The volume terms into `volume` and `rhs_volume`. Returns an inverted cell, or -1.
+  int assemble_volume(const detail::AssemblyInputT<Dim>& in, int nthreads, double& bad) {
+    return cells.assemble(in, 0, mesh().cell_count(), nthreads, volume.valuePtr(), rhs_volume, bad);
+  }
 };
-
-// Sparsity: per column the sorted rows coupled to it by some triangle; the CSC structure and
-// every triangle's positions in it.
-template <int Dim>
-void BasicFlowSolver<Dim>::Impl::build_pattern() {
-  const int ndof = dof.dofs, ne = mesh().cell_count();
-  local = element->local_size();
-  element_dofs.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local));
-  for (int e = 0; e < ne; ++e) element->element_dofs(e, &element_dofs[static_cast<std::size_t>(e * local)]);
-  std::vector<std::vector<int>> rows(static_cast<std::size_t>(ndof));
-  for (int e = 0; e < ne; ++e)
-    for (int i = 0; i < local; ++i)
-      for (int j = 0; j < local; ++j) rows[static_cast<std::size_t>(dofs_of(e)[i])].push_back(dofs_of(e)[j]);
-  std::size_t nnz = 0;
-  for (auto& list : rows) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    nnz += list.size();
-  }
-  matrix.resize(ndof, ndof);
-  matrix.resizeNonZeros(static_cast<Eigen::Index>(nnz));
-  int pos = 0;
-  for (int c = 0; c < ndof; ++c) {
-    matrix.outerIndexPtr()[c] = pos;
-    for (int r : rows[static_cast<std::size_t>(c)]) matrix.innerIndexPtr()[pos++] = r;
-  }
-  matrix.outerIndexPtr()[ndof] = pos;
-  std::fill(matrix.valuePtr(), matrix.valuePtr() + nnz, 0.0);
-  volume = matrix;
-  scatter.resize(static_cast<std::size_t>(ne) * static_cast<std::size_t>(local * local));
-  for (int e = 0; e < ne; ++e) {
-    const int* d = dofs_of(e);
-    for (int j = 0; j < local; ++j) {
-      const auto& list = rows[static_cast<std::size_t>(d[j])];
-      for (int i = 0; i < local; ++i) {
-        const auto it = std::lower_bound(list.begin(), list.end(), d[i]);
-        scatter[static_cast<std::size_t>(e) * static_cast<std::size_t>(local * local) +
-                static_cast<std::size_t>(local * j + i)] =
-            matrix.outerIndexPtr()[d[j]] + static_cast<int>(it - list.begin());
-      }
-    }
-  }
-}
-
-// The volume terms into `volume` and `rhs_volume` (threads: each its own copy of the values,
-// summed in thread order). Returns an inverted triangle (with its `bad` measure), or -1.
-template <int Dim>
-int BasicFlowSolver<Dim>::Impl::assemble_volume(const detail::AssemblyInputT<Dim>& in, int nthreads, double& bad) {
-  const std::size_t nnz = static_cast<std::size_t>(matrix.nonZeros());
-  thread_values.resize(static_cast<std::size_t>(nthreads));
-  std::vector<Eigen::VectorXd> thread_rhs(static_cast<std::size_t>(nthreads), Eigen::VectorXd::Zero(dof.dofs));
-  int bad_element = -1;
-  const int ne = mesh().cell_count();
-#pragma omp parallel num_threads(nthreads)
-  {
-#ifdef _OPENMP
-    const int tid = omp_get_thread_num();
-#else
-    const int tid = 0;
-#endif
-    auto& values = thread_values[static_cast<std::size_t>(tid)];
-    values.assign(nnz, 0.0);
-    auto& b = thread_rhs[static_cast<std::size_t>(tid)];
-    detail::LocalSystem s;
-#pragma omp for schedule(static)
-    for (int e = 0; e < ne; ++e) {
-      double measure = 0;
-      if (!element->assemble(e, in, s, measure)) {
-#pragma omp critical
-        {
-          bad_element = e;
-          bad = measure;
-        }
-        continue;
-      }
-      add(e, s, values.data(), b);
-    }
-  }
-  double* vv = volume.valuePtr();
-  std::copy(thread_values[0].begin(), thread_values[0].end(), vv);
-  rhs_volume = thread_rhs[0];
-  for (int t = 1; t < nthreads; ++t) {
-    const auto& tv = thread_values[static_cast<std::size_t>(t)];
-    for (std::size_t k = 0; k < nnz; ++k) vv[k] += tv[k];
-    rhs_volume += thread_rhs[static_cast<std::size_t>(t)];
-  }
-  return bad_element;
-}
 
 // Everything a solve of one time level fixes before its iterations.
 template <int Dim>
