@@ -1,12 +1,16 @@
 // The PETSc engines on however many MPI ranks this test runs on (ctest: 1 rank, and 2 ranks
 // under mpirun: fluid.mpi_two_ranks): the 3D plane Poiseuille problem of test_tet.cpp solved by
 // MUMPS and by the field-split GMRES equals the UMFPACK solution on rank 0. Ranks other than 0
-// serve the PETSc solves (start_mpi_ranks), as in fluid_server.
+// serve the PETSc solves (start_mpi_ranks), as in fluid_server. On 2 ranks the element matrices
+// are computed by both (the distributed assembly): a moving-mesh Navier-Stokes step equals rank
+// 0's assembly alone, and an inverted cell in either rank's block is reported.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include "fsi/fluid/flow_solver.hpp"
 #include "fsi/fluid/linear_solver.hpp"
@@ -42,7 +46,9 @@ Eigen::VectorXd poiseuille(LinearEngine engine, const std::string& options, int&
 TEST(PetscRanks, MumpsAndFieldSplitEqualUmfpack) {
   if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
   std::printf("MPI ranks: %d\n", mpi_world_size());
-  if (expected_ranks > 0) EXPECT_EQ(mpi_world_size(), expected_ranks);
+  if (expected_ranks > 0) {
+    EXPECT_EQ(mpi_world_size(), expected_ranks);
+  }
   int its = 0;
   const auto lu = poiseuille(LinearEngine::Umfpack, "", its);
   const auto mumps = poiseuille(LinearEngine::Mumps, "", its);
@@ -50,6 +56,69 @@ TEST(PetscRanks, MumpsAndFieldSplitEqualUmfpack) {
   const auto gmres = poiseuille(LinearEngine::Petsc, "-ksp_rtol 1e-13", its);
   EXPECT_GT(its, 0);
   EXPECT_LT((gmres - lu).lpNorm<Eigen::Infinity>(), 1e-9);
+}
+
+// Two BDF2 Newton steps of the channel above on a mesh moved in y (so the ALE mesh velocity,
+// the history and the advection all enter the element matrices), MUMPS; `distributed`: the
+// element matrices computed by every rank (FlowParameters::distributed_assembly).
+Eigen::VectorXd moving_channel(bool distributed, int& assembly_ranks) {
+  const double L = 2, H = 1, U = 1.5, pi = 3.141592653589793;
+  FlowParameters params;
+  params.viscosity = 0.05;
+  params.scheme = TimeScheme::BDF2;
+  params.newton = true;
+  params.max_iterations = 3;
+  params.tolerance = 1e-12;
+  params.engine = LinearEngine::Mumps;
+  params.distributed_assembly = distributed;
+  FlowSolver3 solver(TetMesh::box({0, 0, 0}, {L, H, 0.5}, 6, 3, 2), params, "p2p1");
+  assembly_ranks = solver.assembly_ranks();
+  auto inflow = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
+    return {4 * U * x.y() * (H - x.y()) / (H * H), 0, 0};
+  };
+  for (const char* g : {"left", "bottom", "top"}) solver.add_dirichlet(g, inflow);
+  solver.add_symmetry("back");
+  solver.add_symmetry("front");
+  for (int step = 1; step <= 2; ++step) {
+    Eigen::MatrixX3d x = solver.mesh().nodes;
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      x(i, 1) += 0.03 * step * std::sin(pi * x(i, 0) / L) * std::sin(pi * x(i, 1) / H);
+    solver.solve(0.1 * step, 0.1, x, {});
+    solver.accept();
+  }
+  return solver.solution();
+}
+
+TEST(PetscRanks, DistributedAssemblyEqualsRankZerosAlone) {
+  if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
+  int shared = 0, alone = 0;
+  const auto a = moving_channel(true, shared), b = moving_channel(false, alone);
+  EXPECT_EQ(shared, mpi_world_size());  // every rank computes element matrices
+  EXPECT_EQ(alone, 1);
+  EXPECT_GT(b.norm(), 1.0);
+  EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-12 * b.lpNorm<Eigen::Infinity>());
+}
+
+TEST(PetscRanks, AnInvertedCellOfAnyRanksBlockIsReported) {
+  if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
+  FlowParameters params;
+  params.scheme = TimeScheme::Steady;
+  params.engine = LinearEngine::Mumps;
+  FlowSolver3 solver(TetMesh::box({0, 0, 0}, {2, 1, 0.5}, 6, 3, 2), params, "p2p1");
+  const auto& mesh = solver.mesh();
+  // The last cell (in the last rank's block) folded: its first vertex pushed through the
+  // opposite face.
+  const int e = mesh.cell_count() - 1;
+  Eigen::MatrixX3d x = mesh.nodes;
+  const Eigen::RowVector3d face = (x.row(mesh.tets(e, 1)) + x.row(mesh.tets(e, 2)) + x.row(mesh.tets(e, 3))) / 3.0;
+  x.row(mesh.tets(e, 0)) += 2.5 * (face - x.row(mesh.tets(e, 0)));
+  mesh.interpolate_midpoints(x);
+  try {
+    solver.solve(1, 1, x, {});
+    ADD_FAILURE() << "no error for an inverted tetrahedron";
+  } catch (const MeshTangled& error) {
+    EXPECT_NE(std::string(error.what()).find("10-node tetrahedron"), std::string::npos) << error.what();
+  }
 }
 
 }  // namespace

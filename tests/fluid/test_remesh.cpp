@@ -252,7 +252,7 @@ TEST(FluidInitialState, AnotherMeshAndElementStartFromACheckpoint) {
   Model b(fine);
   std::filesystem::remove(file);
   double worst = 0, scale = 0;
-  for (const Eigen::Vector2d p :
+  for (const Eigen::Vector2d& p :
        {Eigen::Vector2d(0.5, 0.2), Eigen::Vector2d(1.0, 0.3), Eigen::Vector2d(1.5, 0.1), Eigen::Vector2d(0.3, 0.25)}) {
     const Eigen::Vector2d va = a.model.solver().velocity_at(p), vb = b.model.solver().velocity_at(p);
     worst = std::max(worst, (va - vb).norm());

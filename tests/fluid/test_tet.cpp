@@ -135,7 +135,7 @@ TEST(FlowSolver3, PlanePoiseuilleIsExactWithNewton) {
   for (int i = 0; i < solver.mesh().node_count(); ++i)
     err = std::max(err, (v.row(i).transpose() - exact(solver.mesh().nodes.row(i).transpose(), 0)).norm());
   EXPECT_LT(err, 1e-10);
-  for (const Eigen::Vector3d x : {Eigen::Vector3d(0.3, 0.4, 0.2), Eigen::Vector3d(1.7, 0.9, 0.45)}) {
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(0.3, 0.4, 0.2), Eigen::Vector3d(1.7, 0.9, 0.45)}) {
     EXPECT_NEAR(solver.pressure_at(x), 8 * mu * U * (L - x.x()) / (H * H), 1e-9);
     EXPECT_NEAR(solver.velocity_at(x).x(), 4 * U * x.y() * (H - x.y()) / (H * H), 1e-10);
   }

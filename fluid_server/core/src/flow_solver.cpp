@@ -15,9 +15,11 @@
 #include <stdexcept>
 
 #include "flow_element.hpp"
+#include "fsi/common/log.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/field_transfer.hpp"
 #include "fsi/fluid/linear_solver.hpp"
+#include "mpi_ranks.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -282,6 +284,136 @@ struct CellAssembly {
   }
 };
 
+// ---- The distributed assembly (3D, the PETSc engines on several MPI ranks) ----
+// Rank r computes the element matrices of the cells [cell_start(r), cell_start(r + 1)) (blocks
+// of the mesh's cell order); rank 0 gets their sum (MPI_Reduce) and goes on as on one rank (the
+// interface terms, the constraints, the reactions; the solve is distributed by rows). The other
+// ranks hold a replica of the mesh and the element, made from rank 0's broadcast.
+
+int cell_start(int cells, int size, int r) { return r * (cells / size) + std::min(r, cells % size); }
+
+// What the element kernels read of FlowParameters, as numbers to broadcast.
+std::array<double, 10> kernel_parameters(const FlowParameters& p) {
+  const auto& s = p.stabilisation;
+  return {p.density,    p.viscosity, double(p.newton),   double(s.supg),          double(s.pspg),
+          s.lsic_scale, s.grad_div,  s.viscous_constant, double(s.transient_tau), double(s.viscous_residual)};
+}
+void set_kernel_parameters(const std::array<double, 10>& a, FlowParameters& p) {
+  auto& s = p.stabilisation;
+  p.density = a[0], p.viscosity = a[1], p.newton = a[2] != 0, s.supg = a[3] != 0, s.pspg = a[4] != 0;
+  s.lsic_scale = a[5], s.grad_div = a[6], s.viscous_constant = a[7], s.transient_tau = a[8] != 0;
+  s.viscous_residual = a[9] != 0;
+}
+
+// The inputs of one assembly: rank 0's, or a replica's broadcast copies.
+struct AssemblyData {
+  std::array<double, 12> scalars{};  // alpha0_dt, dt, the kernel parameters
+  Eigen::MatrixX3d X, mesh_velocity, body;
+  Eigen::VectorXd U_lin, history;
+};
+
+// Collective: rank 0's data (sizes first) reach every rank.
+void broadcast(AssemblyData& d) {
+  std::array<int, 5> sizes{static_cast<int>(d.X.rows()), static_cast<int>(d.mesh_velocity.rows()),
+                           static_cast<int>(d.body.rows()), static_cast<int>(d.U_lin.size()),
+                           static_cast<int>(d.history.size())};
+  ranks::broadcast(sizes.data(), sizes.size());
+  d.X.resize(sizes[0], 3), d.mesh_velocity.resize(sizes[1], 3), d.body.resize(sizes[2], 3);
+  d.U_lin.resize(sizes[3]), d.history.resize(sizes[4]);
+  ranks::broadcast(d.scalars.data(), d.scalars.size());
+  for (auto* m : {&d.X, &d.mesh_velocity, &d.body}) ranks::broadcast(m->data(), static_cast<std::size_t>(m->size()));
+  for (auto* v : {&d.U_lin, &d.history}) ranks::broadcast(v->data(), static_cast<std::size_t>(v->size()));
+}
+
+// Collective: every rank's part summed into rank 0's values and rhs; rank 0 learns an inverted
+// cell of any rank (the first rank's that has one).
+int reduce_parts(double* values, std::size_t nonzeros, Eigen::VectorXd& rhs, int bad_element, double& bad) {
+  ranks::sum_to_root(values, nonzeros);
+  ranks::sum_to_root(rhs.data(), static_cast<std::size_t>(rhs.size()));
+  const double mine[2] = {static_cast<double>(bad_element), bad};
+  std::vector<double> all(2 * static_cast<std::size_t>(ranks::size()));
+  ranks::gather_to_root(mine, 2, all.data());
+  if (ranks::rank() != 0) return -1;
+  for (std::size_t r = 0; r < all.size(); r += 2)
+    if (all[r] >= 0) {
+      bad = all[r + 1];
+      return static_cast<int>(all[r]);
+    }
+  return -1;
+}
+
+// A rank's replica of rank 0's solver: the mesh, the element and the pattern.
+struct Replica {
+  std::unique_ptr<detail::FlowElementT<3>> element;
+  CellAssembly<3> cells;
+  FlowParameters params;
+  int threads = 1;
+  std::vector<double> values;
+  Eigen::VectorXd rhs;
+};
+
+std::map<int, Replica>& replicas() {
+  static std::map<int, Replica> all;
+  return all;
+}
+
+// Collective: the mesh (the element's, 10-node), the element's name and the threads.
+void broadcast_mesh(TetMesh& mesh, std::string& element, int& threads) {
+  std::array<int, 4> sizes{mesh.node_count(), mesh.cell_count(), mesh.vertex_count, threads};
+  ranks::broadcast(sizes.data(), sizes.size());
+  ranks::broadcast(element);
+  mesh.nodes.resize(sizes[0], 3);
+  mesh.tets.resize(sizes[1], 4);
+  mesh.edge_nodes.resize(sizes[1], 6);
+  mesh.vertex_count = sizes[2];
+  threads = sizes[3];
+  ranks::broadcast(mesh.nodes.data(), static_cast<std::size_t>(mesh.nodes.size()));
+  ranks::broadcast(mesh.tets.data(), static_cast<std::size_t>(mesh.tets.size()));
+  ranks::broadcast(mesh.edge_nodes.data(), static_cast<std::size_t>(mesh.edge_nodes.size()));
+}
+
+// Ranks > 0: rank 0's commands of the distributed assembly.
+void serve_assembly(int command, int id) {
+  if (command == ranks::kAssemblyDestroy) {
+    replicas().erase(id);
+    return;
+  }
+  if (command == ranks::kAssemblyCreate) {
+    TetMesh mesh;
+    std::string element;
+    int threads = 1;
+    broadcast_mesh(mesh, element, threads);
+    Replica r;
+    r.element = make_element(element, std::move(mesh));
+    r.threads = threads;
+    const auto layout = r.element->layout();
+    (void)r.cells.build(*r.element, layout.dofs);
+    r.values.resize(r.cells.nonzeros);
+    replicas()[id] = std::move(r);
+    return;
+  }
+  // kAssemble
+  Replica& r = replicas().at(id);
+  AssemblyData d;
+  broadcast(d);
+  std::array<double, 10> kernel{};
+  std::copy(d.scalars.begin() + 2, d.scalars.end(), kernel.begin());
+  set_kernel_parameters(kernel, r.params);
+  const detail::AssemblyInputT<3> in{d.X,       d.mesh_velocity, d.body,       d.U_lin,
+                                     d.history, r.params,        d.scalars[0], d.scalars[1]};
+  r.element->prepare(in);
+  const int cells = r.element->mesh().cell_count();
+  double bad = 0;
+  const int e =
+      r.cells.assemble(in, cell_start(cells, ranks::size(), ranks::rank()),
+                       cell_start(cells, ranks::size(), ranks::rank() + 1), r.threads, r.values.data(), r.rhs, bad);
+  reduce_parts(r.values.data(), r.cells.nonzeros, r.rhs, e, bad);
+}
+
+const bool assembly_served = ranks::on_command(ranks::kAssemblyCreate, serve_assembly) &&
+                             ranks::on_command(ranks::kAssemble, serve_assembly) &&
+                             ranks::on_command(ranks::kAssemblyDestroy, serve_assembly);
+
 }  // namespace
 
 template <int Dim>
@@ -316,9 +448,48 @@ struct BasicFlowSolver<Dim>::Impl {
     matrix = cells.build(*element, dof.dofs);
     volume = matrix;
   }
+  // The distributed assembly's id (-1: this rank assembles every cell).
+  int distributed = -1;
+  ~Impl() {
+    if (distributed >= 0) ranks::command(ranks::kAssemblyDestroy, distributed);
+  }
+  // 3D with the PETSc engines on several ranks (and fluid.mpi.assembly distributed): the other
+  // ranks make their replicas.
+  void distribute(const FlowParameters& params) {
+    if constexpr (Dim == 3) {
+      if (params.engine == LinearEngine::Umfpack || !params.distributed_assembly || ranks::size() <= 1) return;
+      static int next_id = 0;
+      const int id = next_id++;
+      if (!ranks::command(ranks::kAssemblyCreate, id)) return;
+      TetMesh copy = mesh();
+      std::string name = element->name();
+      int threads = std::max(1, params.threads);
+      broadcast_mesh(copy, name, threads);
+      distributed = id;
+      fsi::logger("fluid")->info("assembly: {} cells over {} MPI ranks ({} to {} cells each)", mesh().cell_count(),
+                                 ranks::size(), mesh().cell_count() / ranks::size(),
+                                 cell_start(mesh().cell_count(), ranks::size(), 1));
+    } else {
+      (void)params;
+    }
+  }
   // The volume terms into `volume` and `rhs_volume`. Returns an inverted cell, or -1.
   int assemble_volume(const detail::AssemblyInputT<Dim>& in, int nthreads, double& bad) {
-    return cells.assemble(in, 0, mesh().cell_count(), nthreads, volume.valuePtr(), rhs_volume, bad);
+    const int all = mesh().cell_count();
+    if (distributed < 0) return cells.assemble(in, 0, all, nthreads, volume.valuePtr(), rhs_volume, bad);
+    if constexpr (Dim == 3) {
+      ranks::command(ranks::kAssemble, distributed);
+      AssemblyData d;
+      d.X = in.X, d.mesh_velocity = in.mesh_velocity, d.body = in.body, d.U_lin = in.U_lin, d.history = in.history;
+      d.scalars[0] = in.alpha0_dt, d.scalars[1] = in.dt;
+      const auto kernel = kernel_parameters(in.params);
+      std::copy(kernel.begin(), kernel.end(), d.scalars.begin() + 2);
+      broadcast(d);
+      const int e =
+          cells.assemble(in, 0, cell_start(all, ranks::size(), 1), nthreads, volume.valuePtr(), rhs_volume, bad);
+      return reduce_parts(volume.valuePtr(), cells.nonzeros, rhs_volume, e, bad);
+    }
+    return -1;
   }
 };
 
@@ -345,6 +516,7 @@ BasicFlowSolver<Dim>::BasicFlowSolver(Mesh mesh, FlowParameters params, const st
   for (int v = 0; v < im.mesh().vertices(); ++v) pressure[static_cast<std::size_t>(im.dof.pressure(v))] = 1;
   im.lu = make_linear_solver(params_, Dim, std::move(pressure));
   im.build_pattern();
+  im.distribute(params_);
   U_ = U_n_ = U_nm1_ = reaction_ = Eigen::VectorXd::Zero(im.dof.dofs);
   X_ = X_n_ = X_nm1_ = im.mesh().nodes;
   interface_segments_.resize(0, 2);
@@ -651,6 +823,11 @@ StepReport BasicFlowSolver<Dim>::solve(Step& step) {
     if (report.change < params_.tolerance) break;
   }
   return report;
+}
+
+template <int Dim>
+int BasicFlowSolver<Dim>::assembly_ranks() const {
+  return impl_->distributed >= 0 ? ranks::size() : 1;
 }
 
 template <int Dim>

@@ -1,12 +1,15 @@
 // make_linear_solver and the MPI environment (linear_solver.hpp).
 #include "fsi/fluid/linear_solver.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
 
 #include "fsi/fluid/sparse_lu.hpp"
 #ifdef FSI_HAVE_PETSC
 #include "petsc_solver.hpp"
+#else
+#include "mpi_ranks.hpp"
 #endif
 
 namespace fsi::fluid {
@@ -62,5 +65,20 @@ int start_mpi_ranks() {
   return -1;
 #endif
 }
+
+#ifndef FSI_HAVE_PETSC
+// Without PETSc there is one rank (mpi_ranks.hpp).
+namespace ranks {
+bool on_command(int, Handler) { return false; }
+int size() { return 1; }
+int rank() { return 0; }
+bool command(int, int) { return false; }
+void broadcast(double*, std::size_t) {}
+void broadcast(int*, std::size_t) {}
+void broadcast(std::string&) {}
+void sum_to_root(double*, std::size_t) {}
+void gather_to_root(const double* mine, int count, double* all) { std::copy(mine, mine + count, all); }
+}  // namespace ranks
+#endif
 
 }  // namespace fsi::fluid

@@ -168,7 +168,8 @@ void read_linear_solver(const schema::Reader& section, bool taylor_hood, int dim
   params.petsc_reuse_preconditioner = params.scheme != TimeScheme::Steady;
   params.engine = dimension == 3 && petsc_available() ? LinearEngine::Petsc : LinearEngine::Umfpack;
   const int ranks = section.get<int>("ranks");
-  (void)section.declared("mpi");  // read by the launcher (fsi run)
+  // fluid.mpi: the launcher's keys (fsi run), and how the ranks share the assembly.
+  params.distributed_assembly = section.child_or_defaults("mpi").get<std::string>("assembly") == "distributed";
   if (ranks != mpi_world_size())
     section.fail("ranks", fmt::format("is {} but this fluid_server runs on {} MPI rank(s): fsi run starts it under "
                                       "mpirun -n {} (or start it so yourself)",

@@ -61,7 +61,7 @@ const std::vector<schema::Key>& navier_stokes_keys() {
       integer("threads", "assembly threads (OpenMP)").def("1"),
       integer("ranks",
               "MPI ranks of the fluid (fsi run starts fluid_server under mpirun -n N; engine petsc or mumps): "
-              "rank 0 assembles, all ranks solve")
+              "all ranks solve; in 3D all ranks assemble (fluid.mpi.assembly)")
           .def("1")
           .ge(1),
       section(
@@ -70,6 +70,10 @@ const std::vector<schema::Key>& navier_stokes_keys() {
               text("command", "the MPI launcher (PATH is searched)").def("mpirun"),
               text("hostfile", "mpirun --hostfile: the hosts of the ranks (relative to the scene file)"),
               string_list("args", "further launcher arguments, e.g. [--oversubscribe] or [--host, a:2,b:2]").def("[]"),
+              choice("assembly", {"distributed", "rank0"},
+                     "3D: distributed = every rank computes the element matrices of its block of cells and rank 0 "
+                     "sums them; rank0 = rank 0 assembles alone (2D always does)")
+                  .def("distributed"),
           }),
       integer("umfpack_irstep", "UMFPACK iterative refinement steps").def("0").ge(0).le(2),
       section("linear_solver",

@@ -26,6 +26,7 @@
 #include "fsi/common/log.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/fluid/linear_solver.hpp"
+#include "mpi_ranks.hpp"
 
 namespace fsi::fluid {
 namespace {
@@ -442,6 +443,12 @@ void receive_command(int& command, int& id) {
   id = message[1];
 }
 
+// Ranks > 0: the handlers of the commands other parts of the fluid registered (mpi_ranks.hpp).
+std::map<int, ranks::Handler>& handlers() {
+  static std::map<int, ranks::Handler> table;
+  return table;
+}
+
 int serve() {
   for (;;) {
     int command = kQuit, id = 0;
@@ -463,6 +470,11 @@ int serve() {
       it->second->solve(Header{}, nullptr, nullptr, nullptr, nullptr);
     } else if (command == kDestroy) {
       served().erase(id);
+    } else if (const auto h = handlers().find(command); h != handlers().end()) {
+      h->second(command, id);
+    } else {
+      std::fprintf(stderr, "fluid_server rank %d: unknown command %d from rank 0\n", g_rank, command);
+      MPI_Abort(PETSC_COMM_WORLD, 3);
     }
   }
   served().clear();
@@ -594,6 +606,62 @@ Eigen::VectorXd PetscSolver::solve(const Eigen::SparseMatrix<double>& A, const E
 void PetscSolver::discard_factors() { impl_->have_pc = false; }
 void PetscSolver::save_state(StateArchive&, const std::string&) const {}
 void PetscSolver::load_state(const StateArchive&, const std::string&) { discard_factors(); }
+
+namespace ranks {
+
+bool on_command(int command, Handler handler) {
+  handlers()[command] = handler;
+  return true;
+}
+
+bool up() {
+  PetscBool initialised = PETSC_FALSE, finalised = PETSC_FALSE;
+  PetscInitialized(&initialised);
+  PetscFinalized(&finalised);
+  return initialised && !finalised;
+}
+
+int size() { return up() ? g_size : 1; }
+int rank() { return up() ? g_rank : 0; }
+
+bool command(int command, int id) {
+  if (!up() || g_size <= 1 || g_rank != 0) return false;
+  send_command(command, id);
+  return true;
+}
+
+namespace {
+// MPI counts are int: long arrays go in pieces.
+constexpr std::size_t kPiece = std::size_t{1} << 30;
+}  // namespace
+
+void broadcast(double* data, std::size_t count) {
+  for (std::size_t k = 0; k < count; k += kPiece)
+    MPI_Bcast(data + k, static_cast<int>(std::min(kPiece, count - k)), MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+}
+
+void broadcast(int* data, std::size_t count) {
+  for (std::size_t k = 0; k < count; k += kPiece)
+    MPI_Bcast(data + k, static_cast<int>(std::min(kPiece, count - k)), MPI_INT, 0, PETSC_COMM_WORLD);
+}
+
+void broadcast(std::string& text) { bcast_string(text); }
+
+void sum_to_root(double* data, std::size_t count) {
+  for (std::size_t k = 0; k < count; k += kPiece) {
+    const int n = static_cast<int>(std::min(kPiece, count - k));
+    if (g_rank == 0)
+      MPI_Reduce(MPI_IN_PLACE, data + k, n, MPI_DOUBLE, MPI_SUM, 0, PETSC_COMM_WORLD);
+    else
+      MPI_Reduce(data + k, nullptr, n, MPI_DOUBLE, MPI_SUM, 0, PETSC_COMM_WORLD);
+  }
+}
+
+void gather_to_root(const double* mine, int count, double* all) {
+  MPI_Gather(mine, count, MPI_DOUBLE, all, count, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+}
+
+}  // namespace ranks
 
 int petsc_start_mpi_ranks() {
   if (env_int("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", 1) <= 1) return -1;

@@ -135,6 +135,9 @@ struct FlowParameters {
   // petsc_rebuild_factor x those of its first solve (+ 5) (and it converges); else rebuild.
   bool petsc_reuse_preconditioner = true;
   double petsc_rebuild_factor = 1.5;
+  // PETSc engines on several MPI ranks, 3D: every rank computes the element matrices of its
+  // block of cells and rank 0 sums them (false: rank 0 assembles alone, as 2D always does).
+  bool distributed_assembly = true;
   // Tests only (the GCL tests' control): the ALE mesh velocity is multiplied by this; anything
   // but 1 is a wrong mesh velocity, which a GCL test must detect.
   double mesh_velocity_scale = 1.0;
@@ -223,6 +226,9 @@ class BasicFlowSolver {
   int dofs() const;
   // Every unknown: P1/P1 (u, v, p) per node; P2/P1 (u, v) per node at 2 i, 2 i + 1, then p per vertex.
   const Eigen::VectorXd& solution() const { return U_; }
+  // The MPI ranks that compute the element matrices (1: this process alone; FlowParameters::
+  // distributed_assembly).
+  int assembly_ranks() const;
   const Eigen::VectorXd& reaction() const { return reaction_; }  // K_vol U - F_vol, every unknown
   // The system of the last solve (constraints applied) and its right-hand side (benchmarks).
   const Eigen::SparseMatrix<double>& last_matrix() const;
