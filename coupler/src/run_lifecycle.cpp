@@ -189,7 +189,21 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
         "solid's own int N^T N",
         dir, r.restart->step + 1);
   r.out.iterations = static_cast<long>(c.integer("iterations"));
-  r.scheme->load(c);
+  if (r.at_fork && !r.scheme->has_history(c)) {
+    // Forked from another scheme: the scheme's history starts from the checkpoint's state (the
+    // fluid's loads of its last step), as a run from rest starts from the initial state's.
+    FluidLoads loads;
+    {
+      Timer t(times_.fluid);
+      loads = fluid_.initial_loads(map_.to_fluid(st.d_s_prev), map_.to_fluid(st.v_s_prev));
+    }
+    r.scheme->initial_loads(r, loads);
+    r.data["forked_from"]["scheme_history"] = "started from the checkpoint's state";
+    r.log->info("forked into coupling.scheme {}: its history starts from the checkpoint's step {}", r.scheme->name(),
+                r.restart->step);
+  } else {
+    r.scheme->load(c);
+  }
   r.accelerator->load(c, "accelerator.");
 }
 

@@ -282,6 +282,9 @@ struct Coupler::Scheme {
   // What carries over from one step to the next, in the coupler's checkpoint part.
   virtual void save(StateArchive& a) const {}
   virtual void load(const StateArchive& a) {}
+  // Does a checkpoint hold what load() reads? A fork from another scheme's checkpoint that does
+  // not starts the scheme's history from the checkpoint's state, as initial_loads() from rest.
+  virtual bool has_history(const StateArchive& /*a*/) const { return true; }
 
  protected:
   Coupler& c;
@@ -305,6 +308,7 @@ struct Coupler::RobinNeumannScheme : Coupler::Scheme {
   void accept(const Run& r, const Step& step) override;
   void save(StateArchive& a) const override;
   void load(const StateArchive& a) override;
+  bool has_history(const StateArchive& a) const override;
 
  private:
   Eigen::VectorXd coefficient_;    // the Robin coefficient per fluid interface node (m_s / |Gamma| / dt)

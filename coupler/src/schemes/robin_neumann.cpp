@@ -102,11 +102,13 @@ void Coupler::RobinNeumannScheme::save(StateArchive& a) const {
   a.put("robin_neumann.v_nm2", v_nm2_);
 }
 
+bool Coupler::RobinNeumannScheme::has_history(const StateArchive& a) const { return a.has("robin_neumann.f_n"); }
+
 void Coupler::RobinNeumannScheme::load(const StateArchive& a) {
   if (!a.has("robin_neumann.f_n"))
     throw Stop{"failed",
                "the checkpoint holds no Robin-Neumann history (robin_neumann.f_n): a run of another coupling.scheme "
-               "cannot be resumed or forked into scheme robin-neumann"};
+               "cannot be resumed into scheme robin-neumann (a fork, fsi run --from, can)"};
   f_n_ = a.vector("robin_neumann.f_n", fluid_values_);
   f_nm1_ = a.vector("robin_neumann.f_nm1", f_n_.size());
   v_nm1_ = a.vector("robin_neumann.v_nm1", v_nm1_.size());
