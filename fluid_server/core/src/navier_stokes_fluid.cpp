@@ -1,7 +1,6 @@
 #include "fsi/fluid/navier_stokes_fluid.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -49,21 +48,10 @@ std::string read_text(const std::filesystem::path& path) {
 
 // --- fluid.mesh ---
 
-// One place for every run, so a mesh is made once: $FSI_MESH_CACHE, else
-// $XDG_CACHE_HOME/fsi/meshes, else ~/.cache/fsi/meshes (entries keyed by a hash of the .geo
-// text, its parameters and the element order); fluid.mesh.cache_dir overrides it.
+// The mesh cache: fluid.mesh.cache_dir, else the default (fsi/common/gmsh_mesher.hpp).
 std::filesystem::path mesh_cache(const schema::Reader& mesh_section) {
-  std::filesystem::path cache;
-  if (const char* env = std::getenv("FSI_MESH_CACHE"); env && *env)
-    cache = env;
-  else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-    cache = std::filesystem::path(xdg) / "fsi" / "meshes";
-  else if (const char* home = std::getenv("HOME"); home && *home)
-    cache = std::filesystem::path(home) / ".cache" / "fsi" / "meshes";
-  else
-    cache = std::filesystem::temp_directory_path() / "fsi_fluid_meshes";
-  if (mesh_section.has("cache_dir")) cache = mesh_section.get<std::string>("cache_dir");
-  return cache;
+  if (mesh_section.has("cache_dir")) return mesh_section.get<std::string>("cache_dir");
+  return default_mesh_cache();
 }
 
 // The .msh file: fluid.mesh.file, or fluid.mesh.geo meshed by gmsh (cached) with the size h,
@@ -339,36 +327,6 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
 }
 
 }  // namespace
-
-std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
-                               const std::filesystem::path& cache_dir, int order, int dimension) {
-  std::string key = read_text(geo);
-  if (order != 1) key += fmt::format("\norder={}", order);
-  if (dimension != 2) key += fmt::format("\ndimension={}", dimension);
-  for (const auto& [name, value] : parameters) key += fmt::format("\n{}={:.17g}", name, value);
-  const auto hash = std::hash<std::string>{}(key);
-  std::filesystem::create_directories(cache_dir);
-  const auto out = cache_dir / fmt::format("{}_{:016x}.msh", geo.stem().string(), hash);
-  if (std::filesystem::exists(out)) return out;
-  const auto tmp = cache_dir / fmt::format("{}_{:016x}.{}.tmp.msh", geo.stem().string(), hash, ::getpid());
-  const auto log_file = cache_dir / fmt::format("{}_{:016x}.log", geo.stem().string(), hash);
-  std::string cmd = fmt::format("gmsh -{} -format msh22 -v 2", dimension);
-  if (order != 1) cmd += fmt::format(" -order {}", order);
-  for (const auto& [name, value] : parameters) cmd += fmt::format(" -setnumber {} {:.17g}", name, value);
-  cmd += fmt::format(" '{}' -o '{}' > '{}' 2>&1", geo.string(), tmp.string(), log_file.string());
-  std::string what;
-  for (const auto& [name, value] : parameters)
-    what += fmt::format("{}{} = {:g}", what.empty() ? "" : ", ", name, value);
-  fsi::logger("fluid")->info("meshing {} with gmsh ({}{}; log {})", geo.filename().string(), what,
-                             order != 1 ? fmt::format(", order {}", order) : "", log_file.string());
-  fsi::logger("fluid")->debug("{}", cmd);
-  const int rc = std::system(cmd.c_str());
-  if (rc != 0 || !std::filesystem::exists(tmp))
-    throw std::runtime_error(
-        fmt::format("gmsh failed on '{}' (exit {}): {}\n{}", geo.string(), rc, cmd, read_text(log_file)));
-  std::filesystem::rename(tmp, out);
-  return out;
-}
 
 NavierStokesFluid::NavierStokesFluid() = default;
 NavierStokesFluid::~NavierStokesFluid() = default;

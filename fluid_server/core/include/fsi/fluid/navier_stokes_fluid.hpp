@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "fsi/common/gmsh_mesher.hpp"
 #include "fsi/common/scene_schema.hpp"
 #include "fsi/common/solver_model.hpp"
 #include "fsi/common/vtk_writer.hpp"
@@ -26,12 +27,8 @@ class Reader;
 
 namespace fsi::fluid {
 
-// Runs `gmsh -2` on `geo` with `-setnumber name value` for every parameter, caching the
-// .msh in `cache_dir` under a name derived from the geo text and the parameters.
-// `dimension` 3 meshes the volume (gmsh -3). `order` 2 meshes with 6-node triangles and 3-node lines (gmsh -order 2:
-// the midpoints lie on the geometry, so curved boundaries are curved).
-std::filesystem::path mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
-                               const std::filesystem::path& cache_dir, int order = 1, int dimension = 2);
+// Meshing a .geo at run time (cached): fsi/common/gmsh_mesher.hpp.
+using fsi::mesh_geo;
 
 // The keys of `fluid.model: fem` (navier_stokes_keys.cpp).
 const std::vector<schema::Key>& navier_stokes_keys();
