@@ -3,10 +3,12 @@
 // mass, 6-node facets (areas, outward vectors), gmsh tet10 / hex8 meshes read with their
 // facet sets and bad input refused, a cantilever against Timoshenko's beam and the Hex8Eas
 // result, and CSM1 on the shipped tetrahedron mesh.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -467,6 +469,47 @@ TEST(Csm1Tet10, ShippedSceneNearTheReference) {
     EXPECT_NE(what.find("solid.element"), std::string::npos) << what;
     EXPECT_NE(what.find("give tet10"), std::string::npos) << what;
   }
+}
+
+// solid.mesh.geo: the flag's .geo meshed at run time (gmsh -3 -order 2, into a fresh cache) is
+// the shipped .msh, so probe A is the shipped scene's bit for bit; a .geo gmsh cannot mesh is
+// refused naming solid.mesh.geo and gmsh's message.
+TEST(Csm1Tet10, GeoMeshedAtTheStartEqualsTheShippedMesh) {
+  const auto path = repo_root() / "configs/csm1_3d_tet.yaml";
+  const auto cache = std::filesystem::temp_directory_path() / fmt::format("fsi_solid_geo_{}", ::getpid());
+  std::filesystem::remove_all(cache);
+  auto probe_a = [&](const std::vector<std::string>& sets) {
+    const auto scene = fsi::Scene::load(path, sets);
+    FemSolid solid;
+    auto section = scene.section("solid");
+    section.get<std::string>("model");
+    solid.configure(section, fsi::SolidSetup{1.0, 1.0, 0, {}});
+    scene.check_all_used("solid");
+    const fsi::StepInfo info{1.0, 1.0, 1, 0};
+    solid.solve_step(info, Eigen::VectorXd());
+    const auto probes = solid.accept_step(info);
+    return std::array<double, 2>{probes.at("A_x"), probes.at("A_y")};
+  };
+  const auto shipped = probe_a({});
+  const auto meshed =
+      probe_a({"solid.mesh={type: gmsh, geo: meshes/csm_flag_3d.geo, domain: flag, "
+               "parameters: {h: 0.01}, cache_dir: " +
+               cache.string() + "}"});
+  EXPECT_EQ(meshed[0], shipped[0]);
+  EXPECT_EQ(meshed[1], shipped[1]);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(cache), std::filesystem::directory_iterator()), 2);
+
+  const auto broken = cache / "broken.geo";
+  std::ofstream(broken) << "Box(1) = {0, 0, 0, 1, 1;\n";
+  try {
+    probe_a({"solid.mesh={type: gmsh, geo: " + broken.string() + ", cache_dir: " + cache.string() + "}"});
+    ADD_FAILURE() << "no error for a .geo gmsh cannot mesh";
+  } catch (const fsi::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("solid.mesh.geo"), std::string::npos) << what;
+    EXPECT_NE(what.find("gmsh failed"), std::string::npos) << what;
+  }
+  std::filesystem::remove_all(cache);
 }
 
 // ------------------------------------------------------------------ FemSolid on a tet10 .msh

@@ -14,6 +14,7 @@
 #include "fsi/solid/element.hpp"
 
 #ifdef FSI_HAVE_GMSH_READER
+#include "fsi/common/gmsh_mesher.hpp"
 #include "fsi/common/gmsh_reader.hpp"
 #endif
 
@@ -57,15 +58,33 @@ SolidMesh build_mesh(const schema::Reader& m) {
     return rectangle_mesh(origin(0), origin(1), size(0), size(1), n[0], n[1]);
   }
   if (type == "gmsh") {
-    const auto file = m.path("file");
     const auto domain = m.get_or<std::string>("domain", "");
 #ifdef FSI_HAVE_GMSH_READER
+    const std::string source = m.has("geo") ? "geo" : "file";
+    std::filesystem::path file;
+    if (source == "file") {
+      file = m.path("file");
+    } else {
+      std::map<std::string, double> parameters;
+      (void)m.declared("parameters");
+      if (auto extra = m.section().optional_child("parameters"))
+        for (const auto& k : extra->keys()) parameters[k] = extra->get<double>(k);
+      const auto cache =
+          m.has("cache_dir") ? std::filesystem::path(m.get<std::string>("cache_dir")) : fsi::default_mesh_cache();
+      try {
+        file = fsi::mesh_geo(m.path("geo"), parameters, cache, m.get<int>("order"), 3, "solid");
+      } catch (const std::runtime_error& e) {
+        m.fail("geo", e.what());
+      }
+    }
     try {
       return mesh_from_gmsh(fsi::read_gmsh(file), domain);
     } catch (const std::invalid_argument& e) {
-      m.fail("file", e.what());
+      m.fail(source, source == "geo" ? fmt::format("gmsh meshed it into {}, but {}", file.string(), e.what())
+                                     : std::string(e.what()));
     }
 #else
+    const auto file = m.path(m.has("geo") ? "geo" : "file");
     m.fail("type", "gmsh meshes need fsi::read_gmsh, not built into fsi_common yet ('" + file.string() + "')");
 #endif
   }

@@ -35,7 +35,21 @@ const std::vector<schema::Key>& fem_solid_keys() {
                       .only_when("type", {"tube"})
                       .in_unit("m"),
                   number("length", "tube: length along +z").req().gt(0).only_when("type", {"tube"}).in_unit("m"),
-                  text("file", "gmsh mesh, relative to the scene file").req().only_when("type", {"gmsh"}),
+                  text("file", "gmsh .msh, relative to the scene file").group("source").only_when("type", {"gmsh"}),
+                  text("geo", "gmsh .geo, meshed at the start (gmsh -3) once per parameter set into the mesh cache")
+                      .group("source")
+                      .only_when("type", {"gmsh"}),
+                  named_map("parameters", "gmsh -setnumber values of the .geo, name: number (e.g. h: 0.005)",
+                            number("<name>", "value"))
+                      .only_when("geo"),
+                  integer("order",
+                          "gmsh -order: 2 for 10-node tetrahedra, 1 for hexahedra and 2D quadrilaterals (with "
+                          "Recombine in the .geo)")
+                      .def("2")
+                      .ge(1)
+                      .le(2)
+                      .only_when("geo"),
+                  text("cache_dir", "mesh cache; default $FSI_MESH_CACHE, else ~/.cache/fsi/meshes").only_when("geo"),
                   text("domain",
                        "physical group of the solid cells (2D: quadrilaterals; 3D: 10-node tetrahedra or 8-node "
                        "hexahedra); default: every group of the mesh's dimension")
