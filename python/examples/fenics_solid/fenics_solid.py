@@ -78,12 +78,13 @@ class FenicsSolid(fs.Solid):
         _import_fem()
         t0 = time.perf_counter()
         try:
-            self.model = fem.FlagSolid(section, dt, interface_damping, log=_log, element=self.element)
+            self.model = fem.FlagSolid(section, dt, interface_damping, log=_log, element=self.element,
+                                        scene_path=self.scene_path)
         except fem.SceneError as e:
             raise fs.InvalidArgument(f"{self.scene_path}: {e}") from None
         m = self.model
         self.output_dir = output_dir
-        _log(f"{m.dim}D {m.cell} mesh ({m.diagonal if m.cell == 'triangle' else 'structured'}), "
+        _log(f"{m.dim}D {m.cell} mesh ({m.diagonal if m.cell == 'triangle' else m.mesh_file or 'structured'}), "
              f"{m.mesh.num_cells()} cells, "
              f"{'Q' if m.tensor else 'P'}{m.degree}, quadrature degree {m.quadrature_degree}, "
              f"{m.n} dofs ({m.free.size} free), "
