@@ -2,7 +2,8 @@
 protocol here (fenics_solid.py serves it through fsi.server).
 
 A total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible neo-Hookean), 2D
-plane strain or 3D, the dimension taken from the mesh (`rectangle`, `box` or `tube`; one code path for
+plane strain or 3D, the dimension taken from the mesh (`rectangle`, `box`, `tube`, or `gmsh`:
+an MSH 2.2 file of 4- or 10-node tetrahedra, gmsh_tetrahedra below; one code path for
 both: Identity(dim), V.sub(c) for each component), Lagrange elements on triangles /
 tetrahedra (P1, P2, ...) or quadrilaterals / hexahedra (Q1), full Newton with the consistent
 tangent that UFL derives, and the time schemes of solid_server:
@@ -180,8 +181,9 @@ def gmsh_tetrahedra(path, domain=None):
         worst = int(np.argmax(off.max(axis=1)))
         if off[worst].max() > MIDPOINT_TOLERANCE:
             e = volumes[worst]
+            curved = int((off > MIDPOINT_TOLERANCE).any(axis=1).sum())
             raise SceneError(f"'{path}', group '{group(3, e[2])}', element {e[0]}: a mid-edge node is off its edge's "
-                             f"midpoint by {off[worst].max():.2e} of the edge length (a curved cell; {int((off > MIDPOINT_TOLERANCE).any(axis=1).sum())} "
+                             f"midpoint by {off[worst].max():.2e} of the edge length (a curved cell; {curved} "
                              f"such cells): legacy DOLFIN has straight cells only (mesh with gmsh -setnumber "
                              f"Mesh.SecondOrderLinear 1, or 4-node tetrahedra)")
     used = np.unique(nodes[:, :4])
@@ -227,9 +229,10 @@ def gmsh_tetrahedra(path, domain=None):
 class FlagSolid:
     """The solid of one run: mesh, function space, forms, state (d, v, a of the last accepted
     step and of the current solve) and the interface, in 2D or 3D (`dim`, from the mesh:
-    `rectangle`, `box`, `tube` or `gmsh`: a file of tetrahedra). All vectors are numpy arrays over the DOLFIN dofs of V (`dim`
-    components interleaved by DOLFIN's dof map, not necessarily x0 y0 x1 y1: `comp[:, c]` are
-    the dofs of component c, node by node; `ix`, `iy`, `iz` the same by name)."""
+    `rectangle`, `box`, `tube` or `gmsh`: a file of tetrahedra). All vectors are numpy arrays
+    over the DOLFIN dofs of V (`dim` components interleaved by DOLFIN's dof map, not
+    necessarily x0 y0 x1 y1: `comp[:, c]` are the dofs of component c, node by node; `ix`,
+    `iy`, `iz` the same by name)."""
 
     FACET_SETS = ("left", "right", "bottom", "top", "back", "front")  # x, y, z: the first 2 dim
     COMPONENTS = ("x", "y", "z")
@@ -265,7 +268,7 @@ class FlagSolid:
             domain = m.get("domain")
             m.check_all_used()
             self._gmsh = gmsh_tetrahedra(self.mesh_file, None if domain is None else str(domain))
-            self.facet_sets = tuple(self._gmsh[2])
+            self.facet_sets = tuple(sorted(self._gmsh[2]))
 
         # 1. The discretisation: solid.fenics, else `element` (the server's command line), else
         #    Q1 quadrilaterals (hexahedra in 3D) with 2 x 2 (x 2) Gauss points, solid_server's own
