@@ -145,7 +145,8 @@ def gmsh_tetrahedra(path, domain=None):
     tetrahedra must sit at the middle of their edges (MIDPOINT_TOLERANCE of the edge length; a
     straight-sided gmsh mesh does), and only the vertices are kept (P2 on these straight cells
     is the space of solid_server's Tet10). Returns (vertex coordinates, cells (n x 4 vertex
-    rows), {group: (n x 3 vertex rows, gmsh element numbers)}, 1 or 2: the file's order)."""
+    rows), {group: (n x 3 vertex rows, gmsh element numbers)}, 1 or 2: the file's order, the
+    face groups with a face inside the solid (a side of two cells))."""
     names, X, row, elements = read_msh22(path)
 
     def group(dim, tag):
@@ -267,7 +268,7 @@ class FlagSolid:
             self.mesh_file = self._resolve(m.get("file", required=True), scene_path)
             domain = m.get("domain")
             m.check_all_used()
-            self._gmsh = gmsh_tetrahedra(self.mesh_file, None if domain is None else str(domain))
+            self._gmsh = gmsh_tetrahedra(self.mesh_file, str(domain) if domain else None)  # '': every group
             self.facet_sets = tuple(sorted(self._gmsh[2]))
 
         # 1. The discretisation: solid.fenics, else `element` (the server's command line), else
