@@ -39,10 +39,29 @@ coupler and a fluid that exerts no force (python/examples/fenics_solid/scenes/).
     steps): the same numbers and coupling iterations as solid_server's plain hex8 (the same
     element) to 1e-9 relative (measured 1.5e-15).
 
+--part gmsh3d (ctest python.fenics_gmsh3d):
+  - gmsh's 10-node tetrahedra read from a .msh (solid.mesh.type: gmsh): CSM1 on the shipped
+    configs/meshes/csm_flag_3d.msh (697 cells, 4005 free dofs) through the coupler
+    (scenes/csm1_3d_tet.yaml, the mesh found relative to the scene file): the FEniCS solid's P2
+    on the straight tetrahedra is the space of solid_server's Tet10, and both integrate the St.
+    Venant-Kirchhoff forms exactly (integrands of degree 4: FEniCS's degree-4 rule, solid_server's
+    degree-5 rule), so they solve the same discrete equations: A equals solid_server's
+    (configs/csm1_3d_tet.yaml, run here) to 1e-9 relative, the bound of the other same-element
+    checks (measured 2e-14: round-off);
+  - scenes/block_3d_tet.yaml (the block on block_3d_tet.msh, dynamic, Algorithm 2, the 3D
+    surrogate's plate; 3 steps here): the probe histories of both solids to 1e-9 relative
+    (measured 4.8e-15) with the same coupling iterations;
+  - without the coupler: the interface faces of the file's group 'wet' (6-node, counter-clockwise
+    seen from outside, midpoints in gmsh order, mass = area); the same mesh as 4-node
+    tetrahedra: P1 by default with 3-node faces, and P2 on it gives the 10-node file's A_y
+    bit for bit; the files and keys refused with the file and group named (a 2D mesh, a curved
+    mid-edge node, hexahedra, MSH 4.1, binary MSH, a face in two groups, a face group or domain
+    not in the file, a missing file).
+
 Exit 77 (ctest: skipped) when the Python has no dolfin (scripts/install-deps.sh installs
 python3-dolfin).
 
-    test_fenics_solid.py --bin BUILD/bin --source SRC --python PYTHON --part static|csm3|block3d WORK
+    test_fenics_solid.py --bin BUILD/bin --source SRC --python PYTHON --part static|csm3|block3d|gmsh3d WORK
 """
 import argparse
 import csv
@@ -59,7 +78,7 @@ ap = argparse.ArgumentParser()
 ap.add_argument("--bin", required=True)
 ap.add_argument("--source", required=True)
 ap.add_argument("--python", required=True)
-ap.add_argument("--part", choices=("static", "csm3", "block3d"), required=True)
+ap.add_argument("--part", choices=("static", "csm3", "block3d", "gmsh3d"), required=True)
 ap.add_argument("work")
 a = ap.parse_args()
 SRC = Path(a.source).resolve()
@@ -400,6 +419,148 @@ print("ok")
     else:
         check(False, f"csm1_3d neo-Hookean: exit {p.returncode} / {p2.returncode} "
                      f"{(p.stderr + p2.stderr + log_tail(work / 'csm1_3d_nh_q1'))[-800:]}")
+elif a.part == "gmsh3d":
+    fen = f"{a.python} {SOLID}"
+    # 1. CSM1 on the shipped tet10 flag: solid_server alone, the FEniCS solid through the coupler.
+    p, _, wall_ss = fsi_run(SRC / "configs" / "csm1_3d_tet.yaml", work / "csm1_tet_cpp")
+    p2, summary, wall = fsi_run(SCENES / "csm1_3d_tet.yaml", work / "csm1_tet_fenics", solid=fen)
+    timings["csm1_tet_fenics"] = wall
+    if p.returncode == 0 and p2.returncode == 0:
+        ref, got = probes(work / "csm1_tet_cpp"), probes(work / "csm1_tet_fenics")
+        d = max(abs(rel(got[k][-1], ref[k][-1])) for k in ("solid.A_x", "solid.A_y"))
+        check(summary["servers"]["solid"]["name"].startswith("python fenics_solid.py") and d <= 1e-9
+              and summary["interface"]["solid_nodes"] == 743,
+              f"csm1 on csm_flag_3d.msh (tet10): FEniCS P2 A = ({got['solid.A_x'][-1]:.10e}, "
+              f"{got['solid.A_y'][-1]:.10e}),"
+              f" solid_server ({ref['solid.A_x'][-1]:.10e}, {ref['solid.A_y'][-1]:.10e}), max relative difference "
+              f"{d:.1e} (<= 1e-9), {summary['interface']['solid_nodes']} interface nodes (743), {wall:.1f} s")
+    else:
+        check(False, f"csm1 tet10: exit {p.returncode} / {p2.returncode} "
+                     f"{(p.stderr + p2.stderr + log_tail(work / 'csm1_tet_fenics'))[-800:]}")
+    # 2. Coupled, dynamic: the block on gmsh tetrahedra pressed by the surrogate's plate.
+    p, _, _ = fsi_run(SCENES / "block_3d_tet.yaml", work / "block_tet_cpp", "time.end=0.3")
+    p2, _, wall = fsi_run(SCENES / "block_3d_tet.yaml", work / "block_tet_fenics", "time.end=0.3", solid=fen)
+    timings["block_tet_fenics"] = wall
+    if p.returncode == 0 and p2.returncode == 0:
+        ref, got = probes(work / "block_tet_cpp"), probes(work / "block_tet_fenics")
+        keys = [k for k in ref if k.startswith("solid.c")]
+        d = max(abs(rel(y, x)) for k in keys for x, y in zip(ref[k], got[k]))
+        its, its2 = ref["coupling.iterations"], got["coupling.iterations"]
+        check(len(got["time"]) == 3 and d <= 1e-9 and its == its2,
+              f"block_3d_tet dynamic (3 steps), Algorithm 2: FEniCS P2 = solid_server Tet10, max relative difference "
+              f"{d:.1e} "
+              f"(<= 1e-9), coupling iterations {sum(its2):.0f} vs {sum(its):.0f}, {wall:.1f} s")
+    else:
+        check(False, f"block_3d_tet: exit {p.returncode} / {p2.returncode} "
+                     f"{(p.stderr + p2.stderr + log_tail(work / 'block_tet_fenics'))[-800:]}")
+    # 3. Faces and refusals, without the coupler.
+    gmsh_check = r"""
+import os, sys, numpy as np
+sys.path.insert(0, sys.argv[1])
+import fem
+src, work = sys.argv[2], sys.argv[3]
+msh = os.path.join(src, "configs", "meshes", "csm_flag_3d.msh")
+def section(**mesh):
+    m = {"type": "gmsh", "file": msh, "domain": "flag"}
+    m.update(mesh)
+    return {"model": "fem", "mesh": {k: v for k, v in m.items() if v is not None}, "density": 1000.0,
+            "material": {"shear_modulus": 0.5e6, "poisson_ratio": 0.4}, "analysis": "static", "clamp": "clamped",
+            "supports": [{"boundary": "sides", "fixed": ["z"]}], "interface": "wet"}
+m = fem.FlagSolid(section(), 1.0, 0.0, log=lambda *a: None)
+bad = 0
+for f in m.faces:
+    P = m.interface_xy[f]
+    c = P[:3].mean(axis=0)
+    normal = [1, 0, 0] if abs(c[0] - 0.6) < 1e-9 else [0, 1 if c[1] > 0.2 else -1, 0]
+    bad += len(f) != 6 or np.dot(np.cross(P[1] - P[0], P[2] - P[0]), normal) <= 0
+    bad += sum(not np.allclose(P[3 + i], 0.5 * (P[a] + P[b]), atol=1e-15)
+               for i, (a, b) in enumerate(((0, 1), (1, 2), (2, 0))))
+area = (2 * 0.35101 + 0.02) * 0.01
+if bad or len(m.interface_nodes) != 743 or abs(m.M_G.sum() / area - 1) > 1e-12 or m.degree != 2 or m.free.size != 4005:
+    print(f"wet faces: {bad} bad of {len(m.faces)}, {len(m.interface_nodes)} nodes, M_G sum {m.M_G.sum()} "
+          f"(area {area}), "
+          f"P{m.degree}, {m.free.size} free dofs")
+    sys.exit(1)
+text = open(msh).read()
+def write(name, body):
+    path = os.path.join(work, name)
+    open(path, "w").write(body)
+    return path
+lines = text.split("\n")
+k = lines.index("$Nodes") + 1 + 1211  # node 1211: the middle of edge 0-1 of element 605, a tet10 of 'flag'
+x = lines[k].split()
+assert x[0] == "1211"
+lines[k] = f"1211 {float(x[1]) + 1e-4!r} {x[2]} {x[3]}"
+curved = write("curved.msh", "\n".join(lines))
+hexa = write("hexa.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"cube\"\n$EndPhysicalNames\n"
+             "$Nodes\n8\n" + "".join(f"{i + 1} {i & 1} {i >> 1 & 1} {i >> 2}\n" for i in range(8)) + "$EndNodes\n"
+             "$Elements\n1\n1 5 2 1 1 1 2 4 3 5 6 8 7\n$EndElements\n")
+msh41 = write("v41.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n")
+binary = write("binary.msh", "$MeshFormat\n2.2 1 8\n$EndMeshFormat\n")
+# a face in two groups: the first 6-node triangle of 'wet' (physical 4) again in 'sides' (3)
+lines = text.split("\n")
+i = lines.index("$Elements")
+n = int(lines[i + 1])
+first = next(line.split() for line in lines[i + 2:i + 2 + n] if line.split()[1:5:2] == ["9", "4"])
+lines[i + 1] = str(n + 1)
+lines.insert(i + 2 + n, " ".join([str(10 ** 6), "9", "2", "3", "3"] + first[5:]))
+twice = write("twice.msh", "\n".join(lines))
+# the same mesh as 4-node tetrahedra and 3-node triangles: P1 by default, 3-node faces; P2 on it
+# is the 10-node file's solid (the same vertices): A_y of the run through the coupler above to the last bit
+lines = text.split("\n")
+for j in range(i + 2, i + 2 + n):
+    p = lines[j].split()
+    keep = {"11": ("4", 4), "9": ("2", 3)}.get(p[1])
+    if keep:
+        lines[j] = " ".join([p[0], keep[0]] + p[2:3 + int(p[2])] + p[3 + int(p[2]):3 + int(p[2]) + keep[1]])
+p1 = write("p1.msh", "\n".join(lines))
+A = {}
+for name, path, degree in (("tet4", p1, None), ("tet4 P2", p1, 2)):
+    s = section(file=path)
+    s["gravity"] = [0.0, -2.0, 0.0]
+    s["load_steps"] = 4
+    s["probes"] = [{"name": "A", "point": [0.6, 0.2, 0.005]}]
+    q = fem.FlagSolid(s, 1.0, 0.0, log=lambda *a: None, element={"degree": degree})
+    q.solve(1.0, np.zeros(3 * len(q.interface_nodes)))
+    A[name] = (q.degree, {len(f) for f in q.faces}, round(q.M_G.sum(), 12), q.accept()["A_y"])
+if (A["tet4"][:3] != (1, {3}, round(area, 12)) or A["tet4 P2"][:2] != (2, {6})
+        or A["tet4 P2"][3] != float(sys.argv[4])):
+    print(f"4-node file: {A}, the 10-node file's A_y {sys.argv[4]}")
+    sys.exit(1)
+flat = os.path.join(src, "configs", "meshes", "csm_flag.msh")
+cases = [(dict(file=flat, domain=None), [flat, "no 3D elements"]),
+         (dict(file=curved), [curved, "group 'flag', element 605", "mid-edge node"]),
+         (dict(file=hexa, domain=None), [hexa, "group 'cube'", "8-node hexahedra"]),
+         (dict(file=msh41), [msh41, "MSH 4.1", "MSH 2.2"]),
+         (dict(file=binary), [binary, "MSH 2.2 binary", "ASCII"]),
+         (dict(file=twice), [twice, "element 1000000", "'wet'", "'sides'"]),
+         (dict(domain="plate"), [msh, "'plate'", "flag"]),
+         (dict(file="nowhere.msh"), ["nowhere.msh", "not found"])]
+for mesh, words in cases:
+    try:
+        fem.FlagSolid(section(**mesh), 1.0, 0.0, log=lambda *a: None)
+        print(f"{mesh}: accepted"); sys.exit(1)
+    except fem.SceneError as e:
+        if not all(w in str(e) for w in words):
+            print(f"{mesh}: {e} (expected {words})"); sys.exit(1)
+s = section()
+s["clamp"] = "root"
+try:
+    fem.FlagSolid(s, 1.0, 0.0, log=lambda *a: None)
+    print("clamp root: accepted"); sys.exit(1)
+except fem.SceneError as e:
+    if not all(w in str(e) for w in ("'solid.clamp'", "root", msh, "clamped, sides, wet")):
+        print(f"clamp root: {e}"); sys.exit(1)
+print(f"ok: {len(m.faces)} wet faces, area {m.M_G.sum():.10g}; 4-node file P1 (A_y {A['tet4'][3]:.5e}, 3-node "
+      f"faces), P2 on it = the 10-node file's; {len(cases) + 1} refusals named")
+"""
+    a_y = probes(work / "csm1_tet_fenics")["solid.A_y"][-1] if (work / "csm1_tet_fenics" / "probes.csv").exists() else 0
+    p = subprocess.run([a.python, "-c", gmsh_check, str(SOLID.parent), str(SRC), str(work), repr(a_y)],
+                       capture_output=True, text=True, timeout=300)
+    check(p.returncode == 0 and p.stdout.strip().startswith("ok"),
+          f"gmsh tet10 without the coupler: the wet faces (6-node, counter-clockwise from outside, midpoints in gmsh "
+          f"order, mass = area) and bad files / keys refused naming the file and group: "
+          f"{(p.stdout + p.stderr)[-600:]}")
 else:
     out = work / "csm3_p2"
     p, summary, wall = fsi_run(SCENES / "csm3.yaml", out, solid=P2 + " --diagonal right", timeout=900)

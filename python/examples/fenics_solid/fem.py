@@ -2,7 +2,8 @@
 protocol here (fenics_solid.py serves it through fsi.server).
 
 A total Lagrangian hyperelastic solid (St. Venant-Kirchhoff or compressible neo-Hookean), 2D
-plane strain or 3D, the dimension taken from the mesh (`rectangle`, `box` or `tube`; one code path for
+plane strain or 3D, the dimension taken from the mesh (`rectangle`, `box`, `tube`, or `gmsh`:
+an MSH 2.2 file of 4- or 10-node tetrahedra, gmsh_tetrahedra below; one code path for
 both: Identity(dim), V.sub(c) for each component), Lagrange elements on triangles /
 tetrahedra (P1, P2, ...) or quadrilaterals / hexahedra (Q1), full Newton with the consistent
 tangent that UFL derives, and the time schemes of solid_server:
@@ -80,13 +81,159 @@ def tube_mesh(origin, r_inner, r_outer, length, n_theta, n_r, n_z):
     return nodes, np.array(cells, dtype=np.int64), ijk
 
 
+# -- gmsh meshes (solid.mesh.type: gmsh): MSH 2.2 ASCII, 3D, 4- or 10-node tetrahedra --------
+# element dimension by gmsh type (the types a 3D solid mesh may hold; others are refused)
+GMSH_DIMENSION = {15: 0, 1: 1, 8: 1, 26: 1, 2: 2, 3: 2, 9: 2, 10: 2, 16: 2, 20: 2, 21: 2,
+                  4: 3, 5: 3, 6: 3, 7: 3, 11: 3, 12: 3, 13: 3, 14: 3, 17: 3, 18: 3, 19: 3, 29: 3}
+GMSH_NAMES = {4: "4-node tetrahedra", 11: "10-node tetrahedra", 5: "8-node hexahedra", 17: "20-node hexahedra",
+              12: "27-node hexahedra", 6: "6-node prisms", 7: "5-node pyramids", 2: "3-node triangles",
+              9: "6-node triangles", 3: "4-node quadrilaterals", 10: "9-node quadrilaterals",
+              16: "8-node quadrilaterals"}
+TET10_EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (2, 3), (1, 3))  # gmsh: nodes 4..9 at their midpoints
+MIDPOINT_TOLERANCE = 1e-6  # |mid-edge node - edge midpoint| / edge length: a straight cell
+
+
+def read_msh22(path):
+    """A gmsh MSH 2.2 ASCII file: (physical names {(dim, tag): name}, node coordinates (n x 3),
+    {gmsh node number: row}, elements [(number, type, physical tag, [gmsh node numbers])])."""
+    try:
+        with open(path) as fh:
+            lines = fh.read().split("\n")
+    except UnicodeDecodeError:
+        raise SceneError(f"'{path}' is not a text file: this solid reads ASCII MSH 2.2 "
+                         f"(gmsh -format msh22, without -bin)") from None
+    sections, name, body = {}, None, []
+    for line in lines:
+        line = line.strip()
+        if name is None:
+            if line.startswith("$"):
+                name, body = line[1:], []
+        elif line == "$End" + name:
+            sections[name], name = body, None
+        else:
+            body.append(line)
+    if name is not None:
+        raise SceneError(f"'{path}': section ${name} has no $End{name}")
+    fmt = sections.get("MeshFormat", [""])[0].split()
+    if len(fmt) < 2 or not fmt[0].startswith("2") or fmt[1] != "0":
+        got = "no $MeshFormat" if not fmt else f"MSH {fmt[0]}{' binary' if len(fmt) > 1 and fmt[1] != '0' else ''}"
+        raise SceneError(f"'{path}': {got}; this solid reads ASCII MSH 2.2 (gmsh -format msh22)")
+    if "Nodes" not in sections or "Elements" not in sections:
+        raise SceneError(f"'{path}': no $Nodes or no $Elements section")
+    names = {}
+    for line in sections.get("PhysicalNames", [])[1:]:
+        parts = line.split(maxsplit=2)
+        if len(parts) == 3:
+            names[(int(parts[0]), int(parts[1]))] = parts[2].strip().strip('"')
+    try:
+        node_lines = sections["Nodes"][1:1 + int(sections["Nodes"][0])]
+        table = np.array([line.split() for line in node_lines], dtype=float).reshape(-1, 4)
+        elements = []
+        for line in sections["Elements"][1:1 + int(sections["Elements"][0])]:
+            v = [int(x) for x in line.split()]
+            elements.append((v[0], v[1], v[3] if v[2] > 0 else 0, v[3 + v[2]:]))
+    except (ValueError, IndexError) as e:
+        raise SceneError(f"'{path}': not a readable MSH 2.2 file ({e})") from None
+    row = {int(n): k for k, n in enumerate(table[:, 0])}
+    return names, table[:, 1:], row, elements
+
+
+def gmsh_tetrahedra(path, domain=None):
+    """The 3D solid mesh of a gmsh MSH 2.2 file: the 3D physical groups (or only `domain`) of
+    4- or 10-node tetrahedra are the cells, every 2D physical group of 3- or 6-node triangles a
+    face set by its name. Legacy DOLFIN has straight cells: the mid-edge nodes of 10-node
+    tetrahedra must sit at the middle of their edges (MIDPOINT_TOLERANCE of the edge length; a
+    straight-sided gmsh mesh does), and only the vertices are kept (P2 on these straight cells
+    is the space of solid_server's Tet10). Returns (vertex coordinates, cells (n x 4 vertex
+    rows), {group: (n x 3 vertex rows, gmsh element numbers)}, 1 or 2: the file's order, the
+    face groups with a face inside the solid (a side of two cells))."""
+    names, X, row, elements = read_msh22(path)
+
+    def group(dim, tag):
+        return names.get((dim, tag), str(tag))
+
+    volumes = [e for e in elements if GMSH_DIMENSION.get(e[1]) == 3]
+    if not volumes:
+        dims = sorted({GMSH_DIMENSION.get(e[1], -1) for e in elements})
+        raise SceneError(f"'{path}' has no 3D elements (element dimensions {dims}): the FEniCS solid reads 3D "
+                         f"gmsh meshes of 4- or 10-node tetrahedra (a 2D solid is mesh type rectangle)")
+    groups3 = sorted({group(3, e[2]) for e in volumes})
+    if domain is not None:
+        if domain not in groups3:
+            raise SceneError(f"'{path}' has no 3D physical group '{domain}' (its 3D groups: {', '.join(groups3)})")
+        volumes = [e for e in volumes if group(3, e[2]) == domain]
+    types = sorted({e[1] for e in volumes})
+    for t in types:
+        if t not in (4, 11):
+            g = sorted({group(3, e[2]) for e in volumes if e[1] == t})
+            raise SceneError(f"'{path}', group '{g[0]}': {GMSH_NAMES.get(t, f'gmsh element type {t}')}; the FEniCS "
+                             f"solid takes 4- or 10-node tetrahedra from a file (hexahedra: mesh type box or tube)")
+    if len(types) > 1:
+        raise SceneError(f"'{path}': both 4- and 10-node tetrahedra; one cell type per mesh")
+    order = 2 if types[0] == 11 else 1
+    try:
+        nodes = np.array([[row[n] for n in e[3]] for e in volumes], dtype=np.int64)
+    except KeyError as e:
+        raise SceneError(f"'{path}': an element refers to node {e}, which is not in $Nodes") from None
+    if order == 2:
+        a = X[nodes[:, [p for p, _ in TET10_EDGES]]]
+        b = X[nodes[:, [q for _, q in TET10_EDGES]]]
+        off = np.linalg.norm(X[nodes[:, 4:]] - 0.5 * (a + b), axis=2) / np.linalg.norm(b - a, axis=2)
+        worst = int(np.argmax(off.max(axis=1)))
+        if off[worst].max() > MIDPOINT_TOLERANCE:
+            e = volumes[worst]
+            curved = int((off > MIDPOINT_TOLERANCE).any(axis=1).sum())
+            raise SceneError(f"'{path}', group '{group(3, e[2])}', element {e[0]}: a mid-edge node is off its edge's "
+                             f"midpoint by {off[worst].max():.2e} of the edge length (a curved cell; {curved} "
+                             f"such cells): legacy DOLFIN has straight cells only (mesh with gmsh -setnumber "
+                             f"Mesh.SecondOrderLinear 1, or 4-node tetrahedra)")
+    used = np.unique(nodes[:, :4])
+    vertex = np.full(len(X), -1, dtype=np.int64)
+    vertex[used] = np.arange(len(used))
+    cells = vertex[nodes[:, :4]]
+    # the face groups: every 2D physical group, by name; each facet a side of a cell
+    sides = {}
+    for c in cells:
+        for f in ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)):
+            key = tuple(sorted(int(c[k]) for k in f))
+            sides[key] = sides.get(key, 0) + 1
+    faces = {}
+    owner = {}
+    for e in elements:
+        if GMSH_DIMENSION.get(e[1]) != 2:
+            continue
+        name = group(2, e[2])
+        if e[1] not in (2, 9):
+            raise SceneError(f"'{path}', group '{name}': {GMSH_NAMES.get(e[1], f'gmsh element type {e[1]}')}; the "
+                             f"face groups of a tetrahedron mesh are 3- or 6-node triangles")
+        try:
+            tri = tuple(int(vertex[row[n]]) for n in e[3][:3])
+        except KeyError as err:
+            raise SceneError(f"'{path}': an element refers to node {err}, which is not in $Nodes") from None
+        key = tuple(sorted(tri))
+        if -1 in tri or key not in sides:
+            raise SceneError(f"'{path}', group '{name}', element {e[0]}: a triangle that is no side of a "
+                             f"tetrahedron{'' if domain is None else f' of {domain}'}")
+        if owner.get(key, name) != name:
+            raise SceneError(f"'{path}', element {e[0]}: a face in both groups '{owner[key]}' and '{name}'; this "
+                             f"solid takes disjoint face groups")
+        owner[key] = name
+        faces.setdefault(name, ([], []))
+        faces[name][0].append(tri)
+        faces[name][1].append(e[0])
+    groups = {k: (np.array(v[0], dtype=np.int64).reshape(-1, 3), v[1]) for k, v in faces.items()}
+    interior = sorted({owner[k] for k, n in sides.items() if n > 1 and k in owner})
+    return X[used], cells, groups, order, interior
+
+
 # -- the model ----------------------------------------------------------------------------------
 class FlagSolid:
     """The solid of one run: mesh, function space, forms, state (d, v, a of the last accepted
     step and of the current solve) and the interface, in 2D or 3D (`dim`, from the mesh:
-    `rectangle`, `box` or `tube`). All vectors are numpy arrays over the DOLFIN dofs of V (`dim`
-    components interleaved by DOLFIN's dof map, not necessarily x0 y0 x1 y1: `comp[:, c]` are
-    the dofs of component c, node by node; `ix`, `iy`, `iz` the same by name)."""
+    `rectangle`, `box`, `tube` or `gmsh`: a file of tetrahedra). All vectors are numpy arrays
+    over the DOLFIN dofs of V (`dim` components interleaved by DOLFIN's dof map, not
+    necessarily x0 y0 x1 y1: `comp[:, c]` are the dofs of component c, node by node; `ix`,
+    `iy`, `iz` the same by name)."""
 
     FACET_SETS = ("left", "right", "bottom", "top", "back", "front")  # x, y, z: the first 2 dim
     COMPONENTS = ("x", "y", "z")
@@ -96,9 +243,9 @@ class FlagSolid:
     # the same numbers) and its enhanced-strain variant (no enhanced strains here: refused in
     # 2D as always; accepted with a line in the log in 3D, so that solid_server's 3D scenes run)
     SERVER_ELEMENTS = {2: ("q4", "q4_eas"), 3: ("hex8", "h8_eas")}
-    MESH_DIM = {"rectangle": 2, "box": 3, "tube": 3}
+    MESH_DIM = {"rectangle": 2, "box": 3, "tube": 3, "gmsh": 3}
 
-    def __init__(self, section, dt, interface_damping, log=print, element=None):
+    def __init__(self, section, dt, interface_damping, log=print, element=None, scene_path=None):
         self.log = log
         s = Section(section, "solid")
         model = s.get("model", "fenics")
@@ -108,27 +255,37 @@ class FlagSolid:
         self.dt = dt
         self.gamma = float(interface_damping)
 
-        # 0. The dimension, from the mesh: rectangle (2D), box or tube (3D).
+        # 0. The dimension, from the mesh: rectangle (2D), box, tube or a gmsh file of tetrahedra (3D).
         m = s.child("mesh")
         mtype = m.get("type", "rectangle")
         if mtype not in self.MESH_DIM:
             raise SceneError(f"'solid.mesh.type: {mtype}': this solid builds only 'rectangle' (2D), 'box' and 'tube' "
-                             f"(3D) meshes")
+                             f"(3D) meshes, or reads 'gmsh' (3D tetrahedra)")
         dim = self.dim = self.MESH_DIM[mtype]
         self.facet_sets = TUBE_FACET_SETS if mtype == "tube" else self.FACET_SETS[:2 * dim]
+        self.mesh_file = None
+        if mtype == "gmsh":  # read first: its face groups are the facet sets, its order the default degree
+            self.mesh_file = self._resolve(m.get("file", required=True), scene_path)
+            domain = m.get("domain")
+            m.check_all_used()
+            self._gmsh = gmsh_tetrahedra(self.mesh_file, str(domain) if domain else None)  # '': every group
+            self.facet_sets = tuple(sorted(self._gmsh[2]))
 
         # 1. The discretisation: solid.fenics, else `element` (the server's command line), else
         #    Q1 quadrilaterals (hexahedra in 3D) with 2 x 2 (x 2) Gauss points, solid_server's own
         #    element, so that a scene written for solid_server gives its numbers.
+        #    A gmsh file: its tetrahedra, P2 on 10-node (solid_server's Tet10), P1 on 4-node ones.
         element = {k: v for k, v in (element or {}).items() if v is not None}
         fe = s.child("fenics")
         tensor, simplex = self.CELLS[dim]
-        if "cell" not in fe.data and element.get("cell", tensor) not in self.CELLS[dim]:
+        cells = (simplex,) if mtype == "gmsh" else self.CELLS[dim]
+        default_cell = simplex if mtype == "gmsh" else tensor
+        if "cell" not in fe.data and element.get("cell", default_cell) not in cells:
             raise SceneError(f"--cell {element['cell']}: the mesh ('solid.mesh.type: {mtype}') is {dim}D, its cells are "
-                             f"{' or '.join(self.CELLS[dim])}")
-        self.cell = fe.choice("cell", element.get("cell", tensor), self.CELLS[dim])
+                             f"{' or '.join(cells)}" + (f" (the file {self.mesh_file})" if self.mesh_file else ""))
+        self.cell = fe.choice("cell", element.get("cell", default_cell), cells)
         self.tensor = self.cell == tensor
-        self.degree = fe.integer("degree", element.get("degree", 1), minimum=1)
+        self.degree = fe.integer("degree", element.get("degree", self._gmsh[3] if mtype == "gmsh" else 1), minimum=1)
         if self.tensor and self.degree != 1:
             raise SceneError(f"'solid.fenics.degree' must be 1 on {tensor[:-2] + 'a' if dim == 3 else tensor + 's'} (legacy DOLFIN cannot evaluate Q2 "
                              f"at a probe point); use 'cell: {simplex}' for higher degrees")
@@ -140,8 +297,17 @@ class FlagSolid:
         self.diagonal, self.quadrature_degree = diagonal, qdeg
         fe.check_all_used()
         plain, enhanced = self.SERVER_ELEMENTS[dim]
+        if mtype == "gmsh":  # solid_server's element on a tetrahedron file: tet10 (its default there)
+            plain, enhanced = "tet10", None
         element = s.get("element", plain)
-        if element == enhanced and dim == 3:
+        if mtype == "gmsh" and element == "tet10":
+            if self.degree != 2 or self._gmsh[3] != 2:
+                log(f"'solid.element: tet10' is solid_server's 10-node tetrahedron; this solid uses P{self.degree} on "
+                    f"the {'10' if self._gmsh[3] == 2 else '4'}-node tetrahedra of {self.mesh_file}")
+        elif mtype == "gmsh":
+            raise SceneError(f"'solid.element: {element}': the mesh {self.mesh_file} has tetrahedra (solid_server: "
+                             f"tet10; the FEniCS solid's element is set by 'solid.fenics' (cell, degree))")
+        elif element == enhanced and dim == 3:
             # a 3D scene written for solid_server names its EAS element (configs/*_3d.yaml); the
             # run goes on with this solid's element, said in the log (not the same numbers in bending)
             log(f"'solid.element: {element}' is solid_server's enhanced-strain hexahedron; this solid uses its own "
@@ -158,6 +324,8 @@ class FlagSolid:
         #    markers 1, 2, ... in the order of self.facet_sets.
         if mtype == "tube":
             self.mesh, self.markers = self._tube(m)
+        elif mtype == "gmsh":
+            self.mesh, self.markers = self._gmsh_mesh()
         else:
             self.mesh, self.markers = self._rectangle_or_box(m, dim, diagonal)
         family = "Q" if self.tensor else "CG"
@@ -172,13 +340,17 @@ class FlagSolid:
         if not all(np.allclose(coords[self.comp[:, c]], self.node_xy) for c in range(1, dim)):
             raise RuntimeError("the components' dofs of V are not paired node by node")
 
-        shape = mtype
+        shape = f"gmsh mesh {self.mesh_file}" if self.mesh_file else mtype
 
         def edge_ids(key, names):
             bad = [x for x in names if x not in self.facet_sets]
             if bad:
                 raise SceneError(f"'solid.{key}': unknown {'edge' if dim == 2 else 'face'} set(s) {', '.join(bad)} "
-                                 f"(the {shape} has {', '.join(self.facet_sets)})")
+                                 f"(the {shape} has {', '.join(self.facet_sets) or 'no face groups'})")
+            inner = [x for x in names if self.mesh_file and x in self._gmsh[4]]
+            if inner:
+                raise SceneError(f"'solid.{key}': the face group(s) {', '.join(inner)} of {self.mesh_file} lie inside "
+                                 f"the solid (faces of two tetrahedra); this solid takes boundary faces only")
             return [self.facet_sets.index(x) + 1 for x in names]
 
         # 3. Material (3D Lame relations; plane strain in 2D) and density.
@@ -418,6 +590,46 @@ class FlagSolid:
                 if np.all(v[:, axis] == value):
                     arr[f.index()] = s_id + 1
                     break
+        return mesh, markers
+
+    @staticmethod
+    def _resolve(given, scene_path):
+        """A mesh file as solid_server finds it: absolute; else relative to the scene file's
+        folder, to the working directory, or to configs/ (the first that exists)."""
+        given = str(given)
+        if os.path.isabs(given):
+            if not os.path.exists(given):
+                raise SceneError(f"'solid.mesh.file': file '{given}' does not exist")
+            return given
+        scene_dir = os.path.dirname(scene_path) if scene_path and scene_path != "<scene>" else ""
+        candidates = [os.path.join(scene_dir or ".", given), given, os.path.join("configs", given)]
+        for c in candidates:
+            if os.path.exists(c):
+                return os.path.abspath(c)
+        raise SceneError(f"'solid.mesh.file': file '{given}' not found (tried {', '.join(candidates)})")
+
+    def _gmsh_mesh(self):
+        """The DOLFIN mesh of the gmsh file's tetrahedra (vertices only: straight cells) and its
+        face groups as markers 1, 2, ... in the order of self.facet_sets."""
+        X, cells, groups, order, _ = self._gmsh
+        mesh = df.Mesh()
+        editor = df.MeshEditor()
+        editor.open(mesh, "tetrahedron", 3, 3)
+        editor.init_vertices(len(X))
+        editor.init_cells(len(cells))
+        for v, x in enumerate(X):
+            editor.add_vertex(v, x)
+        for c, verts in enumerate(cells):
+            editor.add_cell(c, verts.astype(np.uintp))
+        editor.close(True)
+        mesh.init(2)
+        facet_of = {tuple(sorted(v)): f for f, v in
+                    enumerate(np.array(mesh.topology()(2, 0)(), dtype=np.int64).reshape(-1, 3).tolist())}
+        markers = df.MeshFunction("size_t", mesh, 2, 0)
+        arr = markers.array()
+        for i, name in enumerate(self.facet_sets):
+            for tri in groups[name][0].tolist():
+                arr[facet_of[tuple(sorted(tri))]] = i + 1
         return mesh, markers
 
     # -- helpers ----------------------------------------------------------------------------

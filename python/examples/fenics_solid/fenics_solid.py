@@ -1,19 +1,21 @@
 #!/usr/bin/env python3
 """A FEniCS (legacy DOLFIN) finite-element solid served through fsi.server: it replaces
 solid_server in any scene whose solid is a structured rectangle (2D, e.g. the Turek-Hron flag),
-box or tube (3D: the dimension is the mesh's).
+box or tube, or a gmsh file of tetrahedra (3D: the dimension is the mesh's).
 
     fsi run python/examples/fenics_solid/scenes/csm1.yaml --out runs/csm1_fenics \\
         --solid-command "python3 python/examples/fenics_solid/fenics_solid.py --cell triangle --degree 2"
     fsi run configs/block_3d.yaml --out runs/block_3d_fenics \\
         --solid-command "python3 python/examples/fenics_solid/fenics_solid.py"
 
-It reads the same `solid` section as solid_server's `model: fem` (mesh rectangle, box or tube,
+It reads the same `solid` section as solid_server's `model: fem` (mesh rectangle, box, tube or gmsh,
 material, density, gravity, analysis, time_scheme, load_steps, clamp, supports, interface,
 tractions, point_loads, probes, newton, output_every), so one scene runs with either solid.
 In 3D the interface is sent as faces (dimension 3): Q1 hexahedra (the default on a box) give
 4-node faces, `--cell tetrahedron --degree 1|2` 3- or 6-node triangles (each hexahedron of the
-box or tube cut into 6 tetrahedra). The element is this
+box or tube cut into 6 tetrahedra); a gmsh mesh (`type: gmsh`, ASCII MSH 2.2, 4- or 10-node
+tetrahedra with straight edges) gives P1 or P2 on its tetrahedra (P2 on 10-node ones: the space
+of solid_server's Tet10) and 3- or 6-node faces from its named face groups. The element is this
 solid's own choice: `--cell triangle --degree 2` (accurate on coarse meshes), or a section
 `solid.fenics: {cell, degree, diagonal, quadrature_degree}` in a scene written for it alone
 (solid_server refuses the key). By default it uses solid_server's element (Q1, 2 x 2 Gauss
@@ -78,12 +80,13 @@ class FenicsSolid(fs.Solid):
         _import_fem()
         t0 = time.perf_counter()
         try:
-            self.model = fem.FlagSolid(section, dt, interface_damping, log=_log, element=self.element)
+            self.model = fem.FlagSolid(section, dt, interface_damping, log=_log, element=self.element,
+                                        scene_path=self.scene_path)
         except fem.SceneError as e:
             raise fs.InvalidArgument(f"{self.scene_path}: {e}") from None
         m = self.model
         self.output_dir = output_dir
-        _log(f"{m.dim}D {m.cell} mesh ({m.diagonal if m.cell == 'triangle' else 'structured'}), "
+        _log(f"{m.dim}D {m.cell} mesh ({m.diagonal if m.cell == 'triangle' else m.mesh_file or 'structured'}), "
              f"{m.mesh.num_cells()} cells, "
              f"{'Q' if m.tensor else 'P'}{m.degree}, quadrature degree {m.quadrature_degree}, "
              f"{m.n} dofs ({m.free.size} free), "
