@@ -505,28 +505,27 @@ def recover_kill_3d(env):
         interrupt_and_recover(env, "tube_3d.yaml", sets, ref, env.out(f"recover3d_{victim}"), victim, "kill", at)
 
 
-def recover_kill_fenics(env):
-    """kill -9 of an external solid, the FEniCS one (python/examples/fenics_solid): thick_beam to
-    T = 1 with that solid (its default element, Q1), a checkpoint every 5 steps; the solid is killed
-    at step 23, the launcher starts it again, the coupler resumes from step 20 (the solid `load`s
-    its own checkpoint) and the run ends with probes.csv and iterations.csv byte-identical to the
-    uninterrupted run's. Skipped (77) when this Python has no dolfin."""
+def kill_fenics_and_recover(env, scene, sets, kill_at, resumed_from):
+    """Runs `scene` with the FEniCS solid uninterrupted, then again with --recover 1, kills the
+    FEniCS process with SIGKILL once probes.csv has `kill_at` rows, and checks that the launcher
+    restarted it, the coupler resumed from step `resumed_from` and the tables are byte-identical.
+    Skipped (77) when this Python has no dolfin."""
     import sys
     if subprocess.run([sys.executable, "-c", "import dolfin"], capture_output=True).returncode != 0:
         print(f"skipped: {sys.executable} cannot import dolfin (scripts/install-deps.sh)")
         sys.exit(77)
     script = os.path.join(env.source, "python", "examples", "fenics_solid", "fenics_solid.py")
     solid = ("--solid-command", f"{sys.executable} {script}")
-    sets = ["time.end=1", "time.checkpoint_every=5"]
-    ref = env.out("fenics_ref")
+    name = os.path.splitext(os.path.basename(scene))[0]
+    ref = env.out(f"fenics_ref_{name}")
     t0 = time.time()
-    code, log = finish(launch(env, "thick_beam.yaml", ref, sets, solid), 300)
+    code, log = finish(launch(env, scene, ref, sets, solid), 300)
     assert code == 0, log[-2000:]
     t_ref = time.time() - t0
-    out = env.out("fenics_killed")
+    out = env.out(f"fenics_killed_{name}")
     t0 = time.time()
-    p = launch(env, "thick_beam.yaml", out, sets, solid + ("--recover", "1"))
-    wait_rows(os.path.join(out, "probes.csv"), 23, p, 300)
+    p = launch(env, scene, out, sets, solid + ("--recover", "1"))
+    wait_rows(os.path.join(out, "probes.csv"), kill_at, p, 300)
     victim = None
     for c in psutil.Process(p.pid).children():
         try:
@@ -539,13 +538,31 @@ def recover_kill_fenics(env):
     code, log = finish(p, 300)
     s = assert_final(out, "completed", 0, code)
     rec = s.get("recoveries", [])
-    assert len(rec) == 1 and rec[0]["process"] == "solid_server" and rec[0]["resumed_from_step"] == 20, rec
+    assert len(rec) == 1 and rec[0]["process"] == "solid_server" and rec[0]["resumed_from_step"] == resumed_from, rec
     assert_identical(ref, out)
     assert_no_leftovers(out)
     assert not psutil.pid_exists(victim.pid) or victim.status() == psutil.STATUS_ZOMBIE
-    print(f"FEniCS solid killed at step 23: recovered ({rec[0]['cause']}, "
+    print(f"{name}: FEniCS solid killed at step {kill_at}: recovered ({rec[0]['cause']}, "
           f"resumed from step {rec[0]['resumed_from_step']}, {rec[0]['seconds_lost']:.2f} s lost); probes.csv and "
           f"iterations.csv identical; {t_ref:.1f} s uninterrupted, {time.time() - t0:.1f} s with the recovery")
+
+
+def recover_kill_fenics(env):
+    """kill -9 of an external solid, the FEniCS one (python/examples/fenics_solid): thick_beam to
+    T = 1 with that solid (its default element, Q1), a checkpoint every 5 steps; the solid is killed
+    at step 23, the launcher starts it again, the coupler resumes from step 20 (the solid `load`s
+    its own checkpoint) and the run ends with probes.csv and iterations.csv byte-identical to the
+    uninterrupted run's."""
+    kill_fenics_and_recover(env, "thick_beam.yaml", ["time.end=1", "time.checkpoint_every=5"], 23, 20)
+
+
+def recover_kill_fenics_3d(env):
+    """The same in 3D: the FEniCS solid on gmsh's quadratic tetrahedra (P2, Newmark) pressed by the
+    3D surrogate plate (python/examples/fenics_solid/scenes/block_3d_tet.yaml), 12 steps of 0.01 s,
+    a checkpoint every 4 steps, killed at step 6, resumed from step 4: byte-identical."""
+    scene = os.path.join(env.source, "python", "examples", "fenics_solid", "scenes", "block_3d_tet.yaml")
+    kill_fenics_and_recover(env, scene, ["time.dt=0.01", "time.end=0.12", "time.checkpoint_every=4",
+                                         "time.output_every=0"], 6, 4)
 
 
 def recover_stop(env):
@@ -885,7 +902,7 @@ def full_disk(env):
 
 if __name__ == "__main__":
     main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, recover_kill_3d, resume_refused, fork,
-                                  resume_contact, recover_kill, recover_kill_fenics, recover_stop, recover_gives_up,
+                                  resume_contact, recover_kill, recover_kill_fenics, recover_kill_fenics_3d, recover_stop, recover_gives_up,
                                   exit_paths, coupler_death, coupler_death_before_checkpoint, launcher_killed,
                                   orphan_servers, vtk_output, write_failure, full_disk,
                                   resume_external, resume_before_summary, growth)})
