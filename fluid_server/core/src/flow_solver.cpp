@@ -515,8 +515,8 @@ BasicFlowSolver<Dim>::BasicFlowSolver(Mesh mesh, FlowParameters params, const st
   std::vector<char> pressure(static_cast<std::size_t>(im.dof.dofs), 0);
   for (int v = 0; v < im.mesh().vertices(); ++v) pressure[static_cast<std::size_t>(im.dof.pressure(v))] = 1;
   im.lu = make_linear_solver(params_, Dim, std::move(pressure));
+  im.distribute(params_);  // first: the other ranks build their patterns while this one builds its own
   im.build_pattern();
-  im.distribute(params_);
   U_ = U_n_ = U_nm1_ = reaction_ = Eigen::VectorXd::Zero(im.dof.dofs);
   X_ = X_n_ = X_nm1_ = im.mesh().nodes;
   interface_segments_.resize(0, 2);
