@@ -766,6 +766,21 @@ void BasicFlowSolver<Dim>::restart_history() {
 }
 
 template <int Dim>
+typename BasicFlowSolver<Dim>::History BasicFlowSolver<Dim>::history() const {
+  return History{U_,     U_n_,  U_nm1_,    reaction_, interface_velocity_, X_,    X_n_,
+                 X_nm1_, dt_n_, dt_trial_, accepted_, trial_solves_,       robin_};
+}
+
+template <int Dim>
+void BasicFlowSolver<Dim>::set_history(const History& h) {
+  U_ = h.U, U_n_ = h.U_n, U_nm1_ = h.U_nm1, reaction_ = h.reaction, interface_velocity_ = h.interface_velocity;
+  X_ = h.X, X_n_ = h.X_n, X_nm1_ = h.X_nm1;
+  dt_n_ = h.dt_n, dt_trial_ = h.dt_trial;
+  accepted_ = h.accepted, trial_solves_ = h.trial_solves;
+  robin_ = h.robin;
+}
+
+template <int Dim>
 typename BasicFlowSolver<Dim>::Nodes BasicFlowSolver<Dim>::velocity() const {
   Nodes v(mesh().node_count(), Dim);
   for (int i = 0; i < mesh().node_count(); ++i)

@@ -216,6 +216,18 @@ class BasicFlowSolver {
   // A fresh start from the present velocity and pressure (after transfer_state from another
   // run's state): no history (the next step is BDF1), the mesh at rest, no interface velocity.
   void restart_history();
+  // Waveform windows (NavierStokesFluid::solve_window): the stepping state (solution, BDF
+  // history, positions, step sizes and counts, interface velocity) as a snapshot in memory, and
+  // back; the linear solver is left as it is (its factors stay in use).
+  struct History {
+    Eigen::VectorXd U, U_n, U_nm1, reaction, interface_velocity;
+    Nodes X, X_n, X_nm1;
+    double dt_n = 0, dt_trial = 0;
+    int accepted = 0, trial_solves = 0;
+    bool robin = false;
+  };
+  History history() const;
+  void set_history(const History& h);
 
   // --- results of the last solve ---
   const Mesh& mesh() const;
