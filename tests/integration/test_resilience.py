@@ -289,12 +289,17 @@ def resume_fluid_waveform(env):
     most = max(int(float(row[its])) for row in lines)
     assert worst < 1e-6 and most < 30, (worst, most)
     total = sum(int(float(row[its])) for row in lines)
+    # Each coupling iteration's fluid solve is 2 substeps of one nonlinear iteration each.
+    with open(os.path.join(ref, "iterations.csv")) as f:
+        header, *lines = [line.strip().split(",") for line in f if line.strip()]
+    fluid = {int(float(row[header.index("fluid_iterations")])) for row in lines}
+    assert fluid == {2} and len(lines) == total, (fluid, len(lines), total)
     interrupt_and_recover(env, scene, sets, ref, env.out(f"{name}_recover"), "fluid", "kill", kill_at)
     print(f"fluid.substeps 2: 10 windows converged (largest residual {worst:.2e}, at most {most} iterations, "
           f"{total} coupling iterations = {2 * total} fluid substep solves)")
 
 
-def resume_fsi3(env):def resume_fsi3(env):
+def resume_fsi3(env):
     resume_case(env, "fsi3_iqn", "SIGINT")
 
 
