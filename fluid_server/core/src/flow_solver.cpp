@@ -569,7 +569,7 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
     }
   } else {
     // Nitsche terms on the interface.
-    const detail::NitscheInputT<Dim> nitsche{X_, X_n_, interface_velocity_, params_};
+    const detail::NitscheInputT<Dim> nitsche{X_, penalty_positions(), interface_velocity_, params_};
     detail::LocalSystem s;
     for (const auto& edge : im.edges) {
       im.element->nitsche(edge, nitsche, s);
@@ -781,6 +781,13 @@ void BasicFlowSolver<Dim>::set_history(const History& h) {
 }
 
 template <int Dim>
+void BasicFlowSolver<Dim>::hold_penalty_interface(bool hold) {
+  if (hold && !hold_penalty_) X_penalty_ = X_n_;
+  if (!hold) X_penalty_ = Nodes();
+  hold_penalty_ = hold;
+}
+
+template <int Dim>
 typename BasicFlowSolver<Dim>::Nodes BasicFlowSolver<Dim>::velocity() const {
   Nodes v(mesh().node_count(), Dim);
   for (int i = 0; i < mesh().node_count(); ++i)
@@ -805,7 +812,7 @@ Eigen::SparseMatrix<double> BasicFlowSolver<Dim>::interface_mass() const {
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(9 * impl_->edges.size());
-  const Nodes& X = params_.penalty_on_step_start ? X_n_ : X_;
+  const Nodes& X = params_.penalty_on_step_start ? penalty_positions() : X_;
   for (const auto& edge : impl_->edges) impl_->element->interface_mass(edge, X, t);
   Eigen::SparseMatrix<double> m(n, n);
   m.setFromTriplets(t.begin(), t.end());

@@ -989,8 +989,18 @@ void NavierStokesFluid::solve_on_mesh(const StepInfo& info, const Eigen::VectorX
 
 FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                          const Eigen::VectorXd& interface_velocity) {
-  if (window_) restore_window_start(), window_.reset();  // (a window left open: its start again)
+  if (window_) restore_window_start(), close_window();  // (a window left open: its start again)
   return solve(info, interface_displacement, interface_velocity, nullptr);
+}
+
+void NavierStokesFluid::hold_penalty_interface(bool hold) {
+  if (solver3_) solver3_->hold_penalty_interface(hold);
+  if (solver_) solver_->hold_penalty_interface(hold);
+}
+
+void NavierStokesFluid::close_window() {
+  window_.reset();
+  hold_penalty_interface(false);
 }
 
 bool NavierStokesFluid::supports_substeps() const {
@@ -1042,6 +1052,7 @@ FluidLoads NavierStokesFluid::solve_window(const StepInfo& info, const Waveform&
     w->last_interface_displacement = last_interface_displacement_;
     w->report = last_report_;
     window_ = std::move(w);
+    hold_penalty_interface(true);  // penalty_geometry step_start: the window's start, as the solid's M_G
   }
   const TimeScheme scheme = solver3_ ? solver3_->parameters().scheme : solver_->parameters().scheme;
   Waveform d = displacement, v = velocity;
@@ -1078,7 +1089,7 @@ FluidLoads NavierStokesFluid::solve_window(const StepInfo& info, const Waveform&
 FluidLoads NavierStokesFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                           const RobinCondition& robin) {
   if (!solver_) return FluidModel::solve_robin(info, interface_displacement, robin);  // (3D: throws)
-  if (window_) restore_window_start(), window_.reset();
+  if (window_) restore_window_start(), close_window();
   return solve(info, interface_displacement, Eigen::VectorXd(), &robin);
 }
 
@@ -1151,7 +1162,7 @@ FluidLoads NavierStokesFluid::solve(const StepInfo& info, const Eigen::VectorXd&
 }
 
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
-  window_.reset();  // an open window's end is the state accepted now
+  close_window();  // an open window's end is the state accepted now
   if (solver3_) {
     solver3_->accept();
     if (motion3_ && last_interface_displacement_.size() > 0) motion3_->accept(last_interface_displacement_);
@@ -1264,7 +1275,7 @@ Eigen::VectorXd checked_last_displacement(const StateArchive& state, bool moving
 }  // namespace
 
 void NavierStokesFluid::load_state(const StateArchive& state) {
-  window_.reset();
+  close_window();
   if (solver3_) {
     const Eigen::VectorXd last =
         checked_last_displacement(state, motion3_ != nullptr, 3 * solver3_->interface_nodes().size(), false);

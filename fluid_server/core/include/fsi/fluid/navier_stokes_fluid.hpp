@@ -181,6 +181,8 @@ class NavierStokesFluid : public FluidModel {
   std::unique_ptr<WindowStart> window_;
   bool in_window_ = false;  // inside solve_window's substeps (no remeshing retry)
   void restore_window_start();
+  void close_window();
+  void hold_penalty_interface(bool hold);
   void accept_substep();
   void solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                      const Eigen::VectorXd& interface_velocity, const RobinCondition* robin);
