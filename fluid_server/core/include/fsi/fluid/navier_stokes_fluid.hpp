@@ -57,8 +57,10 @@ class NavierStokesFluid : public FluidModel {
   // substep's end (linearly for BDF1, by parabolas for BDF2), the substeps inside the window
   // accepted (flow history, mesh motion), every substep's loads returned. The window's start is
   // kept in memory until accept_step(): a repeated call (the next coupling iteration) restarts
-  // from it. The linear solver's factors stay in use across substeps and calls. A mesh that
-  // folds inside a window is an error (remeshing happens between windows, in accept_step()).
+  // from it. The linear solver's factors stay in use across substeps and calls. With
+  // interface.penalty_geometry step_start the penalty term (and M_f) is on the window's start
+  // for every substep (the solid's damping M_G is one per window). A mesh that folds inside a
+  // window is an error (remeshing happens between windows, in accept_step()).
   bool supports_substeps() const override;
   FluidLoads solve_window(const StepInfo& info, const Waveform& displacement, const Waveform& velocity,
                           int substeps) override;
