@@ -179,6 +179,12 @@ RESUME_CASES = {
                                             "filter_type: qr3, preconditioner: residual-sum}",
                                             "coupling.iterations={max: 8, tolerance: 1.0e-4, stop_if_not_converged: false}"],
                         27, 240),
+    # Waveform iterations with the Navier-Stokes fluid: 2 fluid substeps per window (the window's
+    # start restored at every coupling iteration, its end accepted), IQN-ILS on the window's
+    # samples to 1e-6, across the checkpoint.
+    "thick_beam_fluid_waveform": ("thick_beam.yaml", ["time.end=0.2", "time.checkpoint_every=4", "fluid.substeps=2",
+                                                      "coupling.acceleration=iqn-ils", "coupling.relaxation=0.1",
+                                                      "coupling.iterations={max: 30, tolerance: 1.0e-6}"], 6, 240),
     # Remeshing (fluid.remesh.at_steps): the checkpoint of step 20 holds the mesh of the remesh
     # after step 15; the resumed run makes the remesh after step 25 itself.
     "thick_beam_remesh": ("thick_beam.yaml", ["time.end=1.0", "time.checkpoint_every=10",
@@ -266,6 +272,32 @@ def resume_remesh(env):
     assert "remesh 2 at step 25" in log, log[-2000:]
     s = summary(env.out("thick_beam_remesh_cut"))
     assert s["wall_time"]["fluid_breakdown"]["remeshes"] == 2, s["wall_time"]["fluid_breakdown"]
+
+
+def resume_fluid_waveform(env):
+    """fluid.substeps 2 (the Navier-Stokes fluid in two substeps per coupling window) on the thick
+    beam: every window converges; stopped by SIGINT and resumed (--resume), and its fluid_server
+    killed (kill -9) and recovered, both end byte-identical to the uninterrupted run."""
+    name = "thick_beam_fluid_waveform"
+    resume_case(env, name, "SIGINT")
+    scene, sets, kill_at, limit = RESUME_CASES[name]
+    ref = env.out(f"{name}_ref")
+    with open(os.path.join(ref, "probes.csv")) as f:
+        header, *lines = [line.strip().split(",") for line in f if line.strip()]
+    its, res = header.index("coupling.iterations"), header.index("coupling.residual")
+    assert len(lines) == 10, len(lines)
+    worst = max(float(row[res]) for row in lines)
+    most = max(int(float(row[its])) for row in lines)
+    assert worst < 1e-6 and most < 30, (worst, most)
+    total = sum(int(float(row[its])) for row in lines)
+    # Each coupling iteration's fluid solve is 2 substeps of one nonlinear iteration each.
+    with open(os.path.join(ref, "iterations.csv")) as f:
+        header, *lines = [line.strip().split(",") for line in f if line.strip()]
+    fluid = {int(float(row[header.index("fluid_iterations")])) for row in lines}
+    assert fluid == {2} and len(lines) == total, (fluid, len(lines), total)
+    interrupt_and_recover(env, scene, sets, ref, env.out(f"{name}_recover"), "fluid", "kill", kill_at)
+    print(f"fluid.substeps 2: 10 windows converged (largest residual {worst:.2e}, at most {most} iterations, "
+          f"{total} coupling iterations = {2 * total} fluid substep solves)")
 
 
 def resume_fsi3(env):
@@ -901,7 +933,7 @@ def full_disk(env):
 
 
 if __name__ == "__main__":
-    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_remesh, resume_fsi3, resume_tube_3d, recover_kill_3d, resume_refused, fork,
+    main({f.__name__: f for f in (resume_small, resume_thick_beam, resume_fluid_waveform, resume_remesh, resume_fsi3, resume_tube_3d, recover_kill_3d, resume_refused, fork,
                                   resume_contact, recover_kill, recover_kill_fenics, recover_kill_fenics_3d, recover_stop, recover_gives_up,
                                   exit_paths, coupler_death, coupler_death_before_checkpoint, launcher_killed,
                                   orphan_servers, vtk_output, write_failure, full_disk,

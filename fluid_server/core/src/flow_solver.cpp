@@ -762,7 +762,7 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
     }
   } else {
     // Nitsche terms on the interface.
-    const detail::NitscheInputT<Dim> nitsche{X_, X_n_, interface_velocity_, params_};
+    const detail::NitscheInputT<Dim> nitsche{X_, penalty_positions(), interface_velocity_, params_};
     detail::LocalSystem s;
     for (const auto& edge : im.edges) {
       im.element->nitsche(edge, nitsche, s);
@@ -964,6 +964,28 @@ void BasicFlowSolver<Dim>::restart_history() {
 }
 
 template <int Dim>
+typename BasicFlowSolver<Dim>::History BasicFlowSolver<Dim>::history() const {
+  return History{U_,     U_n_,  U_nm1_,    reaction_, interface_velocity_, X_,    X_n_,
+                 X_nm1_, dt_n_, dt_trial_, accepted_, trial_solves_,       robin_};
+}
+
+template <int Dim>
+void BasicFlowSolver<Dim>::set_history(const History& h) {
+  U_ = h.U, U_n_ = h.U_n, U_nm1_ = h.U_nm1, reaction_ = h.reaction, interface_velocity_ = h.interface_velocity;
+  X_ = h.X, X_n_ = h.X_n, X_nm1_ = h.X_nm1;
+  dt_n_ = h.dt_n, dt_trial_ = h.dt_trial;
+  accepted_ = h.accepted, trial_solves_ = h.trial_solves;
+  robin_ = h.robin;
+}
+
+template <int Dim>
+void BasicFlowSolver<Dim>::hold_penalty_interface(bool hold) {
+  if (hold && !hold_penalty_) X_penalty_ = X_n_;
+  if (!hold) X_penalty_ = Nodes();
+  hold_penalty_ = hold;
+}
+
+template <int Dim>
 typename BasicFlowSolver<Dim>::Nodes BasicFlowSolver<Dim>::velocity() const {
   Nodes v(mesh().node_count(), Dim);
   for (int i = 0; i < mesh().node_count(); ++i)
@@ -988,7 +1010,7 @@ Eigen::SparseMatrix<double> BasicFlowSolver<Dim>::interface_mass() const {
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(9 * impl_->edges.size());
-  const Nodes& X = params_.penalty_on_step_start ? X_n_ : X_;
+  const Nodes& X = params_.penalty_on_step_start ? penalty_positions() : X_;
   for (const auto& edge : impl_->edges) impl_->element->interface_mass(edge, X, t);
   Eigen::SparseMatrix<double> m(n, n);
   m.setFromTriplets(t.begin(), t.end());

@@ -7,6 +7,7 @@
 #include <Eigen/SparseCore>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "fsi/common/solver_model.hpp"
@@ -87,7 +88,8 @@ struct BasicMeshMotion<Dim>::Impl {
   std::vector<int> free_index;   // node -> free vertex index or -1 (prescribed, or an edge midpoint)
   int nfree = 0;
   Eigen::SparseMatrix<double> coupling;  // free unknowns x prescribed unknowns (all nodes * comps)
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+  using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
+  std::shared_ptr<Factor> solver = std::make_shared<Factor>();  // shared with a snapshot until the next build
   bool analysed = false;
   // Incremental state: the mesh of the last accepted step.
   Nodes base_displacement;      // n x Dim, from the reference
@@ -150,12 +152,16 @@ void BasicMeshMotion<Dim>::Impl::build(const Nodes& positions) {
   coupling.resize(comps * nfree, comps * nodes);
   coupling.setFromTriplets(kfp.begin(), kfp.end());
   if (nfree > 0) {
+    if (solver.use_count() > 1) {  // a snapshot holds these factors: factorise into new ones
+      solver = std::make_shared<Factor>();
+      analysed = false;
+    }
     if (!analysed) {
-      solver.analyzePattern(K);
+      solver->analyzePattern(K);
       analysed = true;
     }
-    solver.factorize(K);
-    if (solver.info() != Eigen::Success)
+    solver->factorize(K);
+    if (solver->info() != Eigen::Success)
       throw SolverError("mesh motion: factorisation of the extension operator failed");
   }
 }
@@ -166,13 +172,13 @@ auto BasicMeshMotion<Dim>::Impl::solve(const Nodes& prescribed_values) const -> 
   if (nfree > 0 && prescribed_values.cwiseAbs().maxCoeff() != 0) {
     if (comps == 1) {
       const Eigen::MatrixXd rhs = -(coupling * prescribed_values);
-      const Eigen::MatrixXd free = solver.solve(rhs);
+      const Eigen::MatrixXd free = solver->solve(rhs);
       for (int i = 0; i < nodes; ++i)
         if (const int f = free_index[static_cast<std::size_t>(i)]; f >= 0) result.row(i) = free.row(f);
     } else {
       Eigen::VectorXd p(Dim * nodes);
       for (int i = 0; i < nodes; ++i) p.template segment<Dim>(Dim * i) = prescribed_values.row(i).transpose();
-      const Eigen::VectorXd free = solver.solve(Eigen::VectorXd(-(coupling * p)));
+      const Eigen::VectorXd free = solver->solve(Eigen::VectorXd(-(coupling * p)));
       for (int i = 0; i < nodes; ++i)
         if (const int f = free_index[static_cast<std::size_t>(i)]; f >= 0)
           result.row(i) = free.template segment<Dim>(Dim * f).transpose();
@@ -274,6 +280,33 @@ void BasicMeshMotion<Dim>::load_state(const StateArchive& state, const std::stri
   m.base_moving = std::move(moving);
   if (m.options.incremental) m.build(m.mesh->nodes + m.base_displacement);
   m.seconds += now() - start;
+}
+
+template <int Dim>
+struct BasicMeshMotion<Dim>::Snapshot {
+  Nodes base_displacement;
+  Eigen::VectorXd base_moving;
+  Eigen::SparseMatrix<double> coupling;
+  std::shared_ptr<typename Impl::Factor> solver;
+  bool analysed = false;
+};
+
+template <int Dim>
+auto BasicMeshMotion<Dim>::snapshot() const -> std::shared_ptr<const Snapshot> {
+  const auto& m = *impl_;
+  auto s = std::make_shared<Snapshot>();
+  s->base_displacement = m.base_displacement;
+  s->base_moving = m.base_moving;
+  if (m.options.incremental) s->coupling = m.coupling, s->solver = m.solver, s->analysed = m.analysed;
+  return s;
+}
+
+template <int Dim>
+void BasicMeshMotion<Dim>::restore(const Snapshot& s) {
+  auto& m = *impl_;
+  m.base_displacement = s.base_displacement;
+  m.base_moving = s.base_moving;
+  if (m.options.incremental) m.coupling = s.coupling, m.solver = s.solver, m.analysed = s.analysed;
 }
 
 template class BasicMeshMotion<2>;

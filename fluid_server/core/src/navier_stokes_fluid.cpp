@@ -328,6 +328,16 @@ VelocityFunction inflow_velocity(const schema::Reader& inflow, const FluidMesh& 
 
 }  // namespace
 
+// The start of an open waveform window: the accepted state the window's substeps start from.
+struct NavierStokesFluid::WindowStart {
+  FlowSolver::History flow;
+  FlowSolver3::History flow3;
+  std::shared_ptr<const MeshMotion::Snapshot> motion;
+  std::shared_ptr<const MeshMotion3::Snapshot> motion3;
+  Eigen::VectorXd last_interface_displacement;
+  StepReport report;
+};
+
 NavierStokesFluid::NavierStokesFluid() = default;
 NavierStokesFluid::~NavierStokesFluid() = default;
 
@@ -938,12 +948,107 @@ void NavierStokesFluid::solve_on_mesh(const StepInfo& info, const Eigen::VectorX
 
 FluidLoads NavierStokesFluid::solve_step(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                          const Eigen::VectorXd& interface_velocity) {
+  if (window_) restore_window_start(), close_window();  // (a window left open: its start again)
   return solve(info, interface_displacement, interface_velocity, nullptr);
+}
+
+void NavierStokesFluid::hold_penalty_interface(bool hold) {
+  if (solver3_) solver3_->hold_penalty_interface(hold);
+  if (solver_) solver_->hold_penalty_interface(hold);
+}
+
+void NavierStokesFluid::close_window() {
+  window_.reset();
+  hold_penalty_interface(false);
+}
+
+bool NavierStokesFluid::supports_substeps() const {
+  const FlowParameters* p = solver_ ? &solver_->parameters() : solver3_ ? &solver3_->parameters() : nullptr;
+  return p && p->scheme != TimeScheme::Steady;
+}
+
+void NavierStokesFluid::restore_window_start() {
+  const WindowStart& w = *window_;
+  if (solver3_) {
+    solver3_->set_history(w.flow3);
+    if (motion3_) motion3_->restore(*w.motion3);
+  } else {
+    solver_->set_history(w.flow);
+    if (motion_) motion_->restore(*w.motion);
+  }
+  last_interface_displacement_ = w.last_interface_displacement;
+  last_report_ = w.report;
+}
+
+// A substep inside a window accepted as accept_step() does, without probes or remeshing.
+void NavierStokesFluid::accept_substep() {
+  if (solver3_) {
+    solver3_->accept();
+    if (motion3_ && last_interface_displacement_.size() > 0) motion3_->accept(last_interface_displacement_);
+    return;
+  }
+  solver_->accept();
+  if (motion_ && last_interface_displacement_.size() > 0) motion_->accept(motion_input(last_interface_displacement_));
+}
+
+// Substeps of h = dt / substeps; like FemSolid::solve_window. The window stays open (its start
+// kept) until accept_step(), which accepts the last substep as a step is accepted.
+FluidLoads NavierStokesFluid::solve_window(const StepInfo& info, const Waveform& displacement, const Waveform& velocity,
+                                           int substeps) {
+  if (!solver_ && !solver3_) throw SolverError("fluid: solve_window before configure");
+  if (!supports_substeps()) return FluidModel::solve_window(info, displacement, velocity, substeps);  // (throws)
+  if (window_) {
+    restore_window_start();
+  } else {
+    auto w = std::make_unique<WindowStart>();
+    if (solver3_) {
+      w->flow3 = solver3_->history();
+      if (motion3_) w->motion3 = motion3_->snapshot();
+    } else {
+      w->flow = solver_->history();
+      if (motion_) w->motion = motion_->snapshot();
+    }
+    w->last_interface_displacement = last_interface_displacement_;
+    w->report = last_report_;
+    window_ = std::move(w);
+    hold_penalty_interface(true);  // penalty_geometry step_start: the window's start, as the solid's M_G
+  }
+  const TimeScheme scheme = solver3_ ? solver3_->parameters().scheme : solver_->parameters().scheme;
+  Waveform d = displacement, v = velocity;
+  d.degree = v.degree = scheme == TimeScheme::BDF1 ? 1 : 2;
+  const double h = info.dt / substeps, t0 = info.time - info.dt;
+  FluidLoads out;
+  Eigen::VectorXd traction, integral;
+  int iterations = 0;
+  in_window_ = true;
+  try {
+    for (int j = 1; j <= substeps; ++j) {
+      if (j > 1) accept_substep();  // the last substep becomes the history of the next
+      const StepInfo sub{substep_time(t0, info.dt, j, substeps), h, info.step, info.iteration};
+      const FluidLoads loads = solve(sub, d.at(sub.time), v.at(sub.time), nullptr);
+      iterations += loads.nonlinear_iterations;
+      const Eigen::Index m = loads.traction_force.size();
+      if (j == 1) traction.resize(m * substeps), integral.resize(m * substeps);
+      traction.segment((j - 1) * m, m) = loads.traction_force;
+      integral.segment((j - 1) * m, m) = loads.velocity_integral;
+      if (j == substeps) out = loads;
+    }
+  } catch (...) {
+    in_window_ = false;
+    restore_window_start();
+    throw;
+  }
+  in_window_ = false;
+  out.traction_samples = std::move(traction);
+  out.velocity_integral_samples = std::move(integral);
+  out.nonlinear_iterations = iterations;
+  return out;
 }
 
 FluidLoads NavierStokesFluid::solve_robin(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                                           const RobinCondition& robin) {
   if (!solver_) return FluidModel::solve_robin(info, interface_displacement, robin);  // (3D: throws)
+  if (window_) restore_window_start(), close_window();
   return solve(info, interface_displacement, Eigen::VectorXd(), &robin);
 }
 
@@ -980,6 +1085,11 @@ FluidLoads NavierStokesFluid::solve(const StepInfo& info, const Eigen::VectorXd&
       // With remeshing on: remesh the step-start mesh once and solve this iteration again on
       // the new mesh; a second fold in the same step is an error.
       if (!remesh_.enabled || !motion_ || retried_step_ == info.step) throw;
+      if (in_window_)
+        throw SolverError(fmt::format(
+            "{}; inside a waveform window (fluid.substeps > 1) a fold is not cured by remeshing the step-start mesh "
+            "(remeshing happens between windows): a smaller time.dt, or fluid.substeps: 1",
+            e.what()));
       fsi::logger("fluid")->warn("fluid: {}; remeshing the step-start mesh and solving again", where(e));
       retried_step_ = info.step;
       try {
@@ -1011,6 +1121,7 @@ FluidLoads NavierStokesFluid::solve(const StepInfo& info, const Eigen::VectorXd&
 }
 
 std::map<std::string, double> NavierStokesFluid::accept_step(const StepInfo& info) {
+  close_window();  // an open window's end is the state accepted now
   if (solver3_) {
     solver3_->accept();
     if (motion3_ && last_interface_displacement_.size() > 0) motion3_->accept(last_interface_displacement_);
@@ -1123,6 +1234,7 @@ Eigen::VectorXd checked_last_displacement(const StateArchive& state, bool moving
 }  // namespace
 
 void NavierStokesFluid::load_state(const StateArchive& state) {
+  close_window();
   if (solver3_) {
     const Eigen::VectorXd last =
         checked_last_displacement(state, motion3_ != nullptr, 3 * solver3_->interface_nodes().size(), false);

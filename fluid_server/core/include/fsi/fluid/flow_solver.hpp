@@ -219,6 +219,23 @@ class BasicFlowSolver {
   // A fresh start from the present velocity and pressure (after transfer_state from another
   // run's state): no history (the next step is BDF1), the mesh at rest, no interface velocity.
   void restart_history();
+  // Waveform windows (NavierStokesFluid::solve_window): the stepping state (solution, BDF
+  // history, positions, step sizes and counts, interface velocity) as a snapshot in memory, and
+  // back; the linear solver is left as it is (its factors stay in use).
+  struct History {
+    Eigen::VectorXd U, U_n, U_nm1, reaction, interface_velocity;
+    Nodes X, X_n, X_nm1;
+    double dt_n = 0, dt_trial = 0;
+    int accepted = 0, trial_solves = 0;
+    bool robin = false;
+  };
+  History history() const;
+  void set_history(const History& h);
+  // Waveform windows with penalty_on_step_start: true = the penalty term's interface (and
+  // interface_mass()) stays where the last accepted step left it at this call (the window's
+  // start) through the substeps accepted after it, as the solid's damping M_G stays for the whole
+  // window; false (the default) = on the last accepted step's interface.
+  void hold_penalty_interface(bool hold);
 
   // --- results of the last solve ---
   const Mesh& mesh() const;
@@ -274,7 +291,10 @@ class BasicFlowSolver {
   IndexMatrix2 interface_segments_;
   std::vector<std::array<int, 6>> interface_faces_;
   Eigen::VectorXd interface_velocity_;  // of the last solve (a Robin solve: v*)
-  bool robin_ = false;                  // the last solve had a Robin interface condition
+  Nodes X_penalty_;                     // hold_penalty_interface(true): the held interface
+  bool hold_penalty_ = false;
+  const Nodes& penalty_positions() const { return hold_penalty_ ? X_penalty_ : X_n_; }
+  bool robin_ = false;  // the last solve had a Robin interface condition
   std::function<void(int, double)> observer_;
   Step begin_step(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
   StepReport solve(Step& step);

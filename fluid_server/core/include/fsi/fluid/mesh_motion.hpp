@@ -75,6 +75,13 @@ class BasicMeshMotion {
   void save_state(StateArchive& state, const std::string& prefix) const;
   void load_state(const StateArchive& state, const std::string& prefix);
 
+  // Waveform windows: the accepted mesh (the incremental state and its factorised operator) as a
+  // snapshot in memory, and back, without a refactorisation (accept() after a snapshot factorises
+  // into a new operator, leaving the snapshot's as it was).
+  struct Snapshot;
+  std::shared_ptr<const Snapshot> snapshot() const;
+  void restore(const Snapshot& snapshot);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -49,6 +49,18 @@ class NavierStokesFluid : public FluidModel {
   bool supports_robin() const override { return solver_ != nullptr; }
   FluidLoads solve_robin(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                          const RobinCondition& robin) override;
+  // Waveform iterations (fluid.substeps > 1; BDF1 and BDF2, 2D and 3D): the window in substeps
+  // from the accepted state, the interface displacement and velocity interpolated in time at each
+  // substep's end (linearly for BDF1, by parabolas for BDF2), the substeps inside the window
+  // accepted (flow history, mesh motion), every substep's loads returned. The window's start is
+  // kept in memory until accept_step(): a repeated call (the next coupling iteration) restarts
+  // from it. The linear solver's factors stay in use across substeps and calls. With
+  // interface.penalty_geometry step_start the penalty term (and M_f) is on the window's start
+  // for every substep (the solid's damping M_G is one per window). A mesh that folds inside a
+  // window is an error (remeshing happens between windows, in accept_step()).
+  bool supports_substeps() const override;
+  FluidLoads solve_window(const StepInfo& info, const Waveform& displacement, const Waveform& velocity,
+                          int substeps) override;
   std::map<std::string, double> accept_step(const StepInfo& info) override;
   std::vector<std::string> write_output(const StepInfo& info) override;
 
@@ -163,6 +175,14 @@ class NavierStokesFluid : public FluidModel {
   Eigen::VectorXd accepted_interface_displacement_;  // of the last accepted step (a remesh's new offset)
   int retried_step_ = -1;                            // the step whose folding motion was remeshed and solved again
   int remesh_retries_ = 0;                           // how many steps were (a count, also in checkpoints)
+  // An open waveform window (solve_window until accept_step): its start.
+  struct WindowStart;
+  std::unique_ptr<WindowStart> window_;
+  bool in_window_ = false;  // inside solve_window's substeps (no remeshing retry)
+  void restore_window_start();
+  void close_window();
+  void hold_penalty_interface(bool hold);
+  void accept_substep();
   void solve_on_mesh(const StepInfo& info, const Eigen::VectorXd& interface_displacement,
                      const Eigen::VectorXd& interface_velocity, const RobinCondition* robin);
   // solve_step and solve_robin (robin: null = Nitsche's terms with interface_velocity).
