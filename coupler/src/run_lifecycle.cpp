@@ -146,12 +146,18 @@ void Coupler::State::save(StateArchive& c) const {
 
 // The coupler's own entries of a checkpoint (the accelerator's and the scheme's are theirs).
 bool Coupler::State::load(const StateArchive& c, Eigen::Index nv, Eigen::Index nf, Eigen::Index ns,
-                          const std::string& dir) {
-  force_n = c.vector("force_n", nf);
-  force_nm1 = c.vector("force_nm1", nf);
+                          const std::string& dir, bool fork, bool* resampled) {
+  // A fork into another fluid.substeps: whole windows of the checkpoint's sample count.
+  const Eigen::Index stored = c.vector("force_n").size();
+  const bool other_samples = fork && stored != nf && nv > 0 && stored > 0 && stored % nv == 0;
+  const Eigen::Index n = other_samples ? stored : nf;
+  force_n = c.vector("force_n", n);
+  force_nm1 = c.vector("force_nm1", n);
   // Before the predictors' longer history: F_n and F_{n-1}.
-  force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", nf) : force_nm1;
-  force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", nf) : force_nm2;
+  force_nm2 = c.has("force_nm2") ? c.vector("force_nm2", n) : force_nm1;
+  force_nm3 = c.has("force_nm3") ? c.vector("force_nm3", n) : force_nm2;
+  if (other_samples) resample_forces(nv, nf);
+  if (resampled) *resampled = other_samples;
   forces_known = c.has("forces_known") ? static_cast<int>(c.integer("forces_known")) : 2;
   d_s_prev = c.vector("d_s_prev", nv);
   d_f_prev = c.vector("d_f_prev", d_f_prev.size());
@@ -179,11 +185,31 @@ bool Coupler::State::load(const StateArchive& c, Eigen::Index nv, Eigen::Index n
   return c.has("mapped_mass.values");
 }
 
+void Coupler::State::resample_forces(Eigen::Index nv, Eigen::Index nf) {
+  const Eigen::Index samples = nf / nv;
+  auto end_value = [nv](const Eigen::VectorXd& f) { return Eigen::VectorXd(f.tail(nv)); };
+  const Eigen::VectorXd e0 = end_value(force_n), e1 = end_value(force_nm1), e2 = end_value(force_nm2),
+                        e3 = end_value(force_nm3);
+  // The window from `a` (the previous window's end) to `b` (this window's end), sample j of
+  // `samples` at the fraction j / samples.
+  auto window = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    Eigen::VectorXd f(nf);
+    for (Eigen::Index j = 1; j <= samples; ++j)
+      f.segment((j - 1) * nv, nv) = a + (static_cast<double>(j) / static_cast<double>(samples)) * (b - a);
+    return f;
+  };
+  force_n = window(e1, e0);
+  force_nm1 = window(e2, e1);
+  force_nm2 = window(e3, e2);
+  force_nm3 = window(e3, e3);
+}
+
 void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   State& st = r.state;
   const Eigen::Index ns = static_cast<Eigen::Index>(solid_interface_.nodes());
   const std::string dir = r.restart->dir.string();
-  if (!st.load(c, r.nv, r.nv * r.n_fluid, ns, dir) && r.implicit && r.gamma_n1 > 0)
+  bool resampled = false;
+  if (!st.load(c, r.nv, r.nv * r.n_fluid, ns, dir, r.at_fork, &resampled) && r.implicit && r.gamma_n1 > 0)
     r.log->warn(
         "checkpoint {} holds no interface mass (an earlier version): the first solve of step {} uses the "
         "solid's own int N^T N",
@@ -204,7 +230,16 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   } else {
     r.scheme->load(c);
   }
-  r.accelerator->load(c, "accelerator.");
+  if (resampled) {
+    // The secant pairs live in the old waveform's space: the accelerator starts afresh.
+    r.accelerator = make_accelerator(settings_);
+    r.data["forked_from"]["forces_resampled"] = fmt::format("{} -> {} samples per window",
+                                                            c.vector("force_n").size() / r.nv, r.n_fluid);
+    r.log->info("forked into fluid.substeps {}: the force histories resampled in time ({} -> {} samples per window)",
+                r.n_fluid, c.vector("force_n").size() / r.nv, r.n_fluid);
+  } else {
+    r.accelerator->load(c, "accelerator.");
+  }
 }
 
 void Coupler::convert_forked_predictor(Run& r, const StateArchive& c) {

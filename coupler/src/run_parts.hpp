@@ -133,8 +133,14 @@ struct Coupler::State {
   // (nv values per vector, ns nodes of mapped_mass) and says whether mapped_mass was there
   // (checkpoints of earlier versions hold none).
   void save(StateArchive& c) const;
-  // (nf values per force: F is the fluid's samples over the window).
-  bool load(const StateArchive& c, Eigen::Index nv, Eigen::Index nf, Eigen::Index ns, const std::string& dir);
+  // (nf values per force: F is the fluid's samples over the window). `fork`: a checkpoint whose
+  // forces hold another number of samples per window (another fluid.substeps) is resampled
+  // (resample_forces); `resampled` says whether it was.
+  bool load(const StateArchive& c, Eigen::Index nv, Eigen::Index nf, Eigen::Index ns, const std::string& dir,
+            bool fork = false, bool* resampled = nullptr);
+  // The force histories of k samples per window as nf / nv samples: piecewise linear in time
+  // through the windows' end values (each force's last sample), constant before the oldest.
+  void resample_forces(Eigen::Index nv, Eigen::Index nf);
 };
 
 // One coupling iteration's solves; the step accepts its last one.

@@ -459,6 +459,19 @@ def fork(env):
     assert len(forked) == 100 and all(t in original for t, _ in forked), len(forked)
     gap = max(abs(d - original[t]) for t, d in forked)
     assert gap < 0.05 * max(abs(d) for _, d in forked), gap
+    # Forked into 2 fluid substeps per window: the checkpoint's force histories (1 sample per
+    # window) are resampled in time, the secant pairs dropped, and the run follows the original.
+    sub = env.out("fork_fluid_substeps")
+    code, log = env.fsi("sdof_model.yaml", sub, *sets, "fluid.substeps=2",
+                        extra=("--from", os.path.join(ref, "checkpoints", "step_00000100")))
+    assert code == 0, log
+    s_sub = summary(sub)
+    assert s_sub["status"] == "completed" and s_sub["forked_from"]["forces_resampled"] == "1 -> 2 samples per window", \
+        s_sub["forked_from"]
+    with open(os.path.join(sub, "probes.csv")) as f:
+        subcycled = [(r["time"], float(r["solid.d_x"])) for r in csv.DictReader(f)]
+    sub_gap = max(abs(d - original[t]) for t, d in subcycled)
+    assert len(subcycled) == 100 and sub_gap < 0.05 * max(abs(d) for _, d in subcycled), sub_gap
     # Another time step would number the steps from another t = 0: refused, naming the key.
     code, log = env.fsi("sdof_model.yaml", env.out("fork_dt"), "time.end=4", "time.dt=0.01", *sets[1:],
                         extra=("--from", ref))
@@ -467,7 +480,8 @@ def fork(env):
     assert code == 1 and "--from" in log and "checkpoint" in log, log
     code, log = env.fsi("sdof_model.yaml", same, *sets, extra=("--from", ref, "--resume"))
     assert code == 1 and "exclude each other" in log, log
-    print(f"fork into robin-neumann: history from the checkpoint, displacement within {gap:.2e} of the original")
+    print(f"fork into robin-neumann: history from the checkpoint, displacement within {gap:.2e} of the original; "
+          f"into 2 fluid substeps: forces resampled, within {sub_gap:.2e}")
     print(f"fork: unchanged fork = the original's rows 101-200 byte for byte; gamma_N1 10 -> 100 forked from step "
           f"{s['forked_from']['step']} and listed; the original untouched; another dt, a folder without checkpoints "
           f"and --from with --resume refused")
