@@ -233,8 +233,8 @@ void Coupler::read_coupler_state(Run& r, const StateArchive& c) {
   if (resampled) {
     // The secant pairs live in the old waveform's space: the accelerator starts afresh.
     r.accelerator = make_accelerator(settings_);
-    r.data["forked_from"]["forces_resampled"] = fmt::format("{} -> {} samples per window",
-                                                            c.vector("force_n").size() / r.nv, r.n_fluid);
+    r.data["forked_from"]["forces_resampled"] =
+        fmt::format("{} -> {} samples per window", c.vector("force_n").size() / r.nv, r.n_fluid);
     r.log->info("forked into fluid.substeps {}: the force histories resampled in time ({} -> {} samples per window)",
                 r.n_fluid, c.vector("force_n").size() / r.nv, r.n_fluid);
   } else {
