@@ -491,6 +491,7 @@ void FemSolid::newton(Eigen::VectorXd& d, const Eigen::VectorXd& f, const TimeTe
 void FemSolid::set_history(const History& h) {
   d_n_ = h.d_n, v_n_ = h.v_n, a_n_ = h.a_n, f_n_ = h.f_n, d_nm1_ = h.d_nm1, v_nm1_ = h.v_nm1;
   accepted_steps_ = h.accepted_steps;
+  dt_n_ = h.dt_n;
 }
 
 SolidStepResult FemSolid::solve_window(const StepInfo& info, const Waveform& force, int substeps) {
@@ -506,6 +507,7 @@ SolidStepResult FemSolid::solve_window(const StepInfo& info, const Waveform& for
       if (j > 1) {  // the last substep becomes the history of the next
         d_nm1_ = d_n_, v_nm1_ = v_n_;
         d_n_ = d_, v_n_ = v_, a_n_ = a_, f_n_ = f_;
+        dt_n_ = dt_solved_;
         ++accepted_steps_;
       }
       const StepInfo sub{substep_time(t0, info.dt, j, substeps), h, info.step, info.iteration};
@@ -544,12 +546,23 @@ SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd
     v_.setZero();
     a_.setZero();
   } else if (scheme_ == TimeScheme::Bdf2 && accepted_steps_ >= 1) {
-    // v = (3 d - 4 d_n + d_nm1) / (2 dt), a = (3 v - 4 v_n + v_nm1) / (2 dt)
     TimeTerms t;
-    t.damping_coefficient = 1.5 / dt;
-    t.velocity_history = (-4.0 * d_n_ + d_nm1_) / (2.0 * dt);
-    t.mass_coefficient = 1.5 / dt * t.damping_coefficient;
-    t.acceleration_history = 1.5 / dt * t.velocity_history - (4.0 * v_n_ - v_nm1_) / (2.0 * dt);
+    const double w = dt_n_ > 0 ? dt / dt_n_ : 1.0;  // this step over the last one
+    if (w == 1.0) {
+      // v = (3 d - 4 d_n + d_nm1) / (2 dt), a = (3 v - 4 v_n + v_nm1) / (2 dt)
+      t.damping_coefficient = 1.5 / dt;
+      t.velocity_history = (-4.0 * d_n_ + d_nm1_) / (2.0 * dt);
+      t.mass_coefficient = 1.5 / dt * t.damping_coefficient;
+      t.acceleration_history = 1.5 / dt * t.velocity_history - (4.0 * v_n_ - v_nm1_) / (2.0 * dt);
+    } else {
+      // Variable steps (w = dt / dt_n): v = (a0 d + a1 d_n + a2 d_nm1) / dt, a alike from v,
+      // a0 = (1 + 2w) / (1 + w), a1 = -(1 + w), a2 = w^2 / (1 + w) (w = 1: the line above).
+      const double a0 = (1 + 2 * w) / (1 + w), a1 = -(1 + w), a2 = w * w / (1 + w);
+      t.damping_coefficient = a0 / dt;
+      t.velocity_history = (a1 * d_n_ + a2 * d_nm1_) / dt;
+      t.mass_coefficient = a0 / dt * t.damping_coefficient;
+      t.acceleration_history = a0 / dt * t.velocity_history + (a1 * v_n_ + a2 * v_nm1_) / dt;
+    }
     d_ = d_n_ + dt * v_n_;
     newton(d_, f_, t, info);
     v_ = t.damping_coefficient * d_ + t.velocity_history;
@@ -577,6 +590,7 @@ SolidStepResult FemSolid::solve_step(const StepInfo& info, const Eigen::VectorXd
     v_ = t.damping_coefficient * d_ + t.velocity_history;
   }
   solved_ = true;
+  dt_solved_ = scheme_ == TimeScheme::Static ? 0.0 : dt;
   SolidStepResult r;
   const auto n = static_cast<Eigen::Index>(interface_nodes_.size());
   const int dim = mesh_.dim;
@@ -607,6 +621,7 @@ std::map<std::string, double> FemSolid::accept_step(const StepInfo& info) {
   if (window_end_) set_history(*window_end_), window_end_.reset();
   d_nm1_ = d_n_, v_nm1_ = v_n_;
   d_n_ = d_, v_n_ = v_, a_n_ = a_, f_n_ = f_;
+  dt_n_ = dt_solved_;
   ++accepted_steps_;
   solved_ = false;
   std::map<std::string, double> probes;
@@ -705,6 +720,7 @@ void FemSolid::save_state(StateArchive& state) {
   state.put("solid.f_n", f_n_);
   state.put("solid.d_nm1", d_nm1_);
   state.put("solid.v_nm1", v_nm1_);
+  state.put("solid.dt_n", dt_n_);
   if (system_->contact()) contact_stats_.save(state);
 }
 
@@ -721,6 +737,7 @@ void FemSolid::load_state(const StateArchive& state) {
   d_nm1_ = state.vector("solid.d_nm1", n);
   v_nm1_ = state.vector("solid.v_nm1", n);
   accepted_steps_ = static_cast<int>(state.integer("solid.accepted_steps"));
+  dt_n_ = state.has("solid.dt_n") ? state.real("solid.dt_n") : 0.0;  // older checkpoints: uniform steps
   contact_stats_ = {};
   if (system_->contact()) contact_stats_.load(state, mesh_.dim);
   d_ = d_n_, v_ = v_n_, a_ = a_n_, f_ = f_n_;

@@ -122,14 +122,18 @@ class FemSolid : public fsi::SolidModel {
   Eigen::VectorXd d_n_, v_n_, a_n_, f_n_;
   Eigen::VectorXd d_nm1_, v_nm1_;  // step n-1 (bdf2), valid once accepted_steps_ >= 1
   int accepted_steps_ = 0;
+  // The step of the last accepted solve (BDF2 takes variable-step coefficients when the next
+  // step differs: a fork into other substeps); 0 = not known (uniform steps assumed).
+  double dt_n_ = 0, dt_solved_ = 0;
   // solve_window(): the history before the window's last substep, from which accept_step()
   // moves on (the accepted history stays the window's start for the next coupling iteration).
   struct History {
     Eigen::VectorXd d_n, v_n, a_n, f_n, d_nm1, v_nm1;
     int accepted_steps = 0;
+    double dt_n = 0;
   };
   std::optional<History> window_end_;
-  History history() const { return {d_n_, v_n_, a_n_, f_n_, d_nm1_, v_nm1_, accepted_steps_}; }
+  History history() const { return {d_n_, v_n_, a_n_, f_n_, d_nm1_, v_nm1_, accepted_steps_, dt_n_}; }
   void set_history(const History& h);
   Eigen::VectorXd d_, v_, a_, f_;
   int last_iterations_ = 0;
