@@ -737,7 +737,8 @@ void FemSolid::load_state(const StateArchive& state) {
   d_nm1_ = state.vector("solid.d_nm1", n);
   v_nm1_ = state.vector("solid.v_nm1", n);
   accepted_steps_ = static_cast<int>(state.integer("solid.accepted_steps"));
-  dt_n_ = state.has("solid.dt_n") ? state.real("solid.dt_n") : 0.0;  // older checkpoints: uniform steps
+  // Checkpoints written before dt_n was saved: one step per window, the scene's time.dt.
+  dt_n_ = state.has("solid.dt_n") ? state.real("solid.dt_n") : setup_.dt;
   contact_stats_ = {};
   if (system_->contact()) contact_stats_.load(state, mesh_.dim);
   d_ = d_n_, v_ = v_n_, a_ = a_n_, f_ = f_n_;

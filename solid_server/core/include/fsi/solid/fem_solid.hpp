@@ -123,7 +123,8 @@ class FemSolid : public fsi::SolidModel {
   Eigen::VectorXd d_nm1_, v_nm1_;  // step n-1 (bdf2), valid once accepted_steps_ >= 1
   int accepted_steps_ = 0;
   // The step of the last accepted solve (BDF2 takes variable-step coefficients when the next
-  // step differs: a fork into other substeps); 0 = not known (uniform steps assumed).
+  // step differs: a fork into other substeps); 0 = not known (uniform steps assumed; a
+  // checkpoint without it: the scene's time.dt).
   double dt_n_ = 0, dt_solved_ = 0;
   // solve_window(): the history before the window's last substep, from which accept_step()
   // moves on (the accepted history stays the window's start for the next coupling iteration).
