@@ -25,6 +25,31 @@ SOURCE = os.path.dirname(os.path.dirname(HERE))
 SCENE = os.path.join(SOURCE, "configs", "cantilever_strip_3d.yaml")
 
 
+def newton_phases(solid, d, f, repeats):
+    """One Newton iteration of the FEniCS solid (python/examples/fenics_solid), `repeats` times, by
+    phases: DOLFIN's assembly, the free block's extraction, SuperLU (COLAMD) factorisation, solve.
+    Lists of seconds per phase, the matrix's and the factors' nonzeros, the solve's residual."""
+    import numpy as np
+    import scipy.sparse.linalg as spla
+    out = {key: [] for key in ("assembly", "extraction", "factorisation", "solve")}
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        r, J = solid._assemble(d, f, 0.0, None, 0.0, None)
+        t1 = time.perf_counter()
+        Jff = J[solid.free][:, solid.free].tocsc()
+        t2 = time.perf_counter()
+        lu = spla.splu(Jff, permc_spec="COLAMD")
+        t3 = time.perf_counter()
+        x = lu.solve(-r)
+        t4 = time.perf_counter()
+        for key, v in zip(("assembly", "extraction", "factorisation", "solve"), (t1 - t0, t2 - t1, t3 - t2, t4 - t3)):
+            out[key].append(v)
+    out["nonzeros"] = int(Jff.nnz)
+    out["factor_nonzeros"] = int(lu.L.nnz + lu.U.nnz)
+    out["relative_residual"] = float(np.linalg.norm(Jff @ x + r) / np.linalg.norm(r))
+    return out
+
+
 def fenics_phases(divisions, repeats):
     """The FEniCS solid's FlagSolid on the scene, its Newton iteration's phases as fem.py runs
     them: DOLFIN assembles F_int and K, the free block is extracted, SuperLU (COLAMD)
@@ -43,23 +68,7 @@ def fenics_phases(divisions, repeats):
     d, f = np.zeros(solid.n), np.ones(solid.n)
     out = {"solver": "fenics", "free_dofs": int(solid.free.size), "setup": setup, "assembly": [], "extraction": [],
            "factorisation": [], "solve": []}
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        r, J = solid._assemble(d, f, 0.0, None, 0.0, None)
-        t1 = time.perf_counter()
-        Jff = J[solid.free][:, solid.free].tocsc()
-        t2 = time.perf_counter()
-        lu = spla.splu(Jff, permc_spec="COLAMD")
-        t3 = time.perf_counter()
-        x = lu.solve(-r)
-        t4 = time.perf_counter()
-        out["assembly"].append(t1 - t0)
-        out["extraction"].append(t2 - t1)
-        out["factorisation"].append(t3 - t2)
-        out["solve"].append(t4 - t3)
-        out["nonzeros"] = int(Jff.nnz)
-        out["factor_nonzeros"] = int(lu.L.nnz + lu.U.nnz)
-        out["relative_residual"] = float(np.linalg.norm(Jff @ x + r) / np.linalg.norm(r))
+    out.update(newton_phases(solid, d, f, repeats))
     out["peak_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     print(json.dumps(out))
 

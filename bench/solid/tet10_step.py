@@ -53,23 +53,9 @@ def fenics_side(mesh, phases):
            "setup": time.perf_counter() - t}
     if phases:
         d, f = np.zeros(solid.n), solid.f_dead
-        for key in ("assembly", "extraction", "factorisation", "solve"):
-            out[key] = []
-        for _ in range(phases):
-            t0 = time.perf_counter()
-            r, J = solid._assemble(d, f, 0.0, None, 0.0, None)
-            t1 = time.perf_counter()
-            Jff = J[solid.free][:, solid.free].tocsc()
-            t2 = time.perf_counter()
-            lu = spla.splu(Jff, permc_spec="COLAMD")
-            t3 = time.perf_counter()
-            lu.solve(-r)
-            t4 = time.perf_counter()
-            laps = (t1 - t0, t2 - t1, t3 - t2, t4 - t3)
-            for key, v in zip(("assembly", "extraction", "factorisation", "solve"), laps):
-                out[key].append(v)
-        out["nonzeros"] = int(Jff.nnz)
-        out["factor_nonzeros"] = int(lu.L.nnz + lu.U.nnz)
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        from phases_3d import newton_phases  # one Newton iteration by phases, as for the hexahedra
+        out.update(newton_phases(solid, d, f, phases))
     else:
         solid.solve(1.0, np.zeros(3 * len(solid.interface_nodes)))
         probes = solid.accept()
