@@ -2,8 +2,9 @@
 // under mpirun: fluid.mpi_two_ranks): the 3D plane Poiseuille problem of test_tet.cpp solved by
 // MUMPS and by the field-split GMRES equals the UMFPACK solution on rank 0. Ranks other than 0
 // serve the PETSc solves (start_mpi_ranks), as in fluid_server. On 2 ranks the element matrices
-// are computed by both (the distributed assembly): a moving-mesh Navier-Stokes step equals rank
-// 0's assembly alone, and an inverted cell in either rank's block is reported.
+// are computed by both (summed on rank 0, or partitioned: each rank keeps its cells and fills its
+// rows): a moving-mesh Navier-Stokes step equals rank 0's assembly alone, and an inverted cell in
+// either rank's block is reported.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -59,9 +60,15 @@ TEST(PetscRanks, MumpsAndFieldSplitEqualUmfpack) {
 }
 
 // Two BDF2 Newton steps of the channel above on a mesh moved in y (so the ALE mesh velocity,
-// the history and the advection all enter the element matrices), MUMPS; `distributed`: the
-// element matrices computed by every rank (FlowParameters::distributed_assembly).
-Eigen::VectorXd moving_channel(bool distributed, int& assembly_ranks) {
+// the history and the advection all enter the element matrices), MUMPS, with the assembly of
+// `mode`: 0 rank 0 alone, 1 every rank's block summed on rank 0, 2 partitioned (each rank keeps
+// its cells and fills its rows of the distributed matrix; FlowParameters::partitioned_assembly).
+// The solution and the reactions (the forces on the walls) of the last step.
+struct Channel {
+  Eigen::VectorXd solution, reaction;
+  int assembly_ranks = 0;
+};
+Channel moving_channel(int mode) {
   const double L = 2, H = 1, U = 1.5, pi = 3.141592653589793;
   FlowParameters params;
   params.viscosity = 0.05;
@@ -70,9 +77,9 @@ Eigen::VectorXd moving_channel(bool distributed, int& assembly_ranks) {
   params.max_iterations = 3;
   params.tolerance = 1e-12;
   params.engine = LinearEngine::Mumps;
-  params.distributed_assembly = distributed;
+  params.distributed_assembly = mode > 0;
+  params.partitioned_assembly = mode == 2;
   FlowSolver3 solver(TetMesh::box({0, 0, 0}, {L, H, 0.5}, 6, 3, 2), params, "p2p1");
-  assembly_ranks = solver.assembly_ranks();
   auto inflow = [&](const Eigen::Vector3d& x, double) -> Eigen::Vector3d {
     return {4 * U * x.y() * (H - x.y()) / (H * H), 0, 0};
   };
@@ -86,17 +93,22 @@ Eigen::VectorXd moving_channel(bool distributed, int& assembly_ranks) {
     solver.solve(0.1 * step, 0.1, x, {});
     solver.accept();
   }
-  return solver.solution();
+  return {solver.solution(), solver.reaction(), solver.assembly_ranks()};
 }
 
-TEST(PetscRanks, DistributedAssemblyEqualsRankZerosAlone) {
+TEST(PetscRanks, DistributedAndPartitionedAssembliesEqualRankZerosAlone) {
   if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
-  int shared = 0, alone = 0;
-  const auto a = moving_channel(true, shared), b = moving_channel(false, alone);
-  EXPECT_EQ(shared, mpi_world_size());  // every rank computes element matrices
-  EXPECT_EQ(alone, 1);
-  EXPECT_GT(b.norm(), 1.0);
-  EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-12 * b.lpNorm<Eigen::Infinity>());
+  const auto alone = moving_channel(0), summed = moving_channel(1), partitioned = moving_channel(2);
+  EXPECT_EQ(alone.assembly_ranks, 1);
+  EXPECT_EQ(summed.assembly_ranks, mpi_world_size());  // every rank computes element matrices
+  EXPECT_EQ(partitioned.assembly_ranks, mpi_world_size());
+  const double u = alone.solution.lpNorm<Eigen::Infinity>(), f = alone.reaction.lpNorm<Eigen::Infinity>();
+  EXPECT_GT(u, 1.0);
+  EXPECT_GT(f, 1e-3);
+  for (const auto* other : {&summed, &partitioned}) {
+    EXPECT_LT((other->solution - alone.solution).lpNorm<Eigen::Infinity>(), 1e-12 * u);
+    EXPECT_LT((other->reaction - alone.reaction).lpNorm<Eigen::Infinity>(), 1e-10 * f);
+  }
 }
 
 TEST(PetscRanks, AnInvertedCellOfAnyRanksBlockIsReported) {

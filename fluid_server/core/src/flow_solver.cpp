@@ -372,10 +372,154 @@ void broadcast_mesh(TetMesh& mesh, std::string& element, int& threads) {
   ranks::broadcast(mesh.edge_nodes.data(), static_cast<std::size_t>(mesh.edge_nodes.size()));
 }
 
+// ---- The partitioned assembly: each rank keeps only its block of cells ----
+
+// A rank's cells [first, last) as a mesh of their own: local node numbers (the cells' vertices
+// first, then their midpoints), the element on it, its pattern (CSC on its own unknowns), and the
+// map of its nodes and unknowns to the whole mesh's. Its matrices go straight into the rows of
+// the distributed matrix (ranks::fill_system).
+struct Part {
+  int first = 0, last = 0;
+  int unknowns = 0;  // of the whole system
+  int threads = 1;
+  std::unique_ptr<detail::FlowElementT<3>> element;
+  CellAssembly<3> cells;
+  Eigen::SparseMatrix<double> volume;
+  Eigen::VectorXd rhs;
+  std::vector<int> node;  // local node -> the mesh's
+  std::vector<int> dof;   // local unknown -> the system's
+  FlowParameters params;
+  Eigen::MatrixX3d X, mesh_velocity, body;  // the inputs at the local nodes and unknowns
+  Eigen::VectorXd U_lin, history;
+
+  ranks::Part view() const {
+    ranks::Part v;
+    v.unknowns = unknowns;
+    v.columns = static_cast<int>(dof.size());
+    v.colptr = volume.outerIndexPtr();
+    v.rowind = volume.innerIndexPtr();
+    v.values = volume.valuePtr();
+    v.global = dof.data();
+    v.rhs = rhs.data();
+    return v;
+  }
+};
+
+// The layout of the whole system as numbers to broadcast.
+std::array<int, 4> layout_numbers(const detail::DofLayout& d) {
+  return {d.dofs, d.velocity_stride, d.pressure_offset, d.pressure_stride};
+}
+
+std::unique_ptr<Part> make_part(const TetMesh& mesh, const std::string& element, const std::array<int, 4>& whole,
+                                int first, int last, int threads) {
+  auto part = std::make_unique<Part>();
+  part->first = first, part->last = last, part->threads = threads, part->unknowns = whole[0];
+  if (first >= last) return part;
+  std::vector<int> local(static_cast<std::size_t>(mesh.node_count()), -1);
+  auto number = [&](int n) {
+    auto& l = local[static_cast<std::size_t>(n)];
+    if (l < 0) {
+      l = static_cast<int>(part->node.size());
+      part->node.push_back(n);
+    }
+    return l;
+  };
+  TetMesh sub;
+  sub.tets.resize(last - first, 4);
+  sub.edge_nodes.resize(last - first, 6);
+  for (int e = first; e < last; ++e)
+    for (int k = 0; k < 4; ++k) sub.tets(e - first, k) = number(mesh.tets(e, k));
+  sub.vertex_count = static_cast<int>(part->node.size());
+  for (int e = first; e < last; ++e)
+    for (int k = 0; k < 6; ++k) sub.edge_nodes(e - first, k) = number(mesh.edge_nodes(e, k));
+  sub.nodes.resize(static_cast<Eigen::Index>(part->node.size()), 3);
+  for (std::size_t i = 0; i < part->node.size(); ++i)
+    sub.nodes.row(static_cast<Eigen::Index>(i)) = mesh.nodes.row(part->node[i]);
+  part->element = make_element(element, std::move(sub));
+  const auto mine = part->element->layout();
+  const detail::DofLayout all{whole[0], whole[1], whole[2], whole[3]};
+  part->dof.assign(static_cast<std::size_t>(mine.dofs), -1);
+  for (std::size_t i = 0; i < part->node.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      part->dof[static_cast<std::size_t>(mine.velocity(static_cast<int>(i), c))] = all.velocity(part->node[i], c);
+  for (int v = 0; v < part->element->mesh().vertices(); ++v)
+    part->dof[static_cast<std::size_t>(mine.pressure(v))] = all.pressure(part->node[static_cast<std::size_t>(v)]);
+  part->volume = part->cells.build(*part->element, mine.dofs);
+  return part;
+}
+
+// The part's element matrices for rank 0's inputs; returns an inverted cell (the mesh's number).
+int assemble_part(Part& p, const AssemblyData& d, double& bad) {
+  if (!p.element) {
+    p.rhs = Eigen::VectorXd::Zero(0);
+    return -1;
+  }
+  std::array<double, 10> kernel{};
+  std::copy(d.scalars.begin() + 2, d.scalars.end(), kernel.begin());
+  set_kernel_parameters(kernel, p.params);
+  const auto n = static_cast<Eigen::Index>(p.node.size());
+  auto rows = [&](const Eigen::MatrixX3d& all, Eigen::MatrixX3d& mine) {
+    mine.setZero(n, 3);
+    if (all.rows() == 0) return;
+    for (Eigen::Index i = 0; i < n; ++i) mine.row(i) = all.row(p.node[static_cast<std::size_t>(i)]);
+  };
+  rows(d.X, p.X), rows(d.mesh_velocity, p.mesh_velocity), rows(d.body, p.body);
+  auto entries = [&](const Eigen::VectorXd& all, Eigen::VectorXd& mine) {
+    mine.setZero(static_cast<Eigen::Index>(p.dof.size()));
+    if (all.size() == 0) return;
+    for (std::size_t i = 0; i < p.dof.size(); ++i) mine(static_cast<Eigen::Index>(i)) = all(p.dof[i]);
+  };
+  entries(d.U_lin, p.U_lin), entries(d.history, p.history);
+  const detail::AssemblyInputT<3> in{p.X,       p.mesh_velocity, p.body,       p.U_lin,
+                                     p.history, p.params,        d.scalars[0], d.scalars[1]};
+  p.element->prepare(in);
+  const int e = p.cells.assemble(in, 0, p.last - p.first, p.threads, p.volume.valuePtr(), p.rhs, bad);
+  return e < 0 ? -1 : p.first + e;
+}
+
+// The part's share of the reactions K_vol U - F_vol, added into `reaction` (every unknown).
+void add_part_reaction(const Part& p, const Eigen::VectorXd& U, Eigen::VectorXd& reaction) {
+  if (!p.element) return;
+  Eigen::VectorXd mine(static_cast<Eigen::Index>(p.dof.size()));
+  for (std::size_t i = 0; i < p.dof.size(); ++i) mine(static_cast<Eigen::Index>(i)) = U(p.dof[i]);
+  const Eigen::VectorXd r = p.volume * mine - p.rhs;
+  for (std::size_t i = 0; i < p.dof.size(); ++i) reaction(p.dof[i]) += r(static_cast<Eigen::Index>(i));
+}
+
+// Collective: every rank learns whether some rank found an inverted cell; rank 0 also which
+// (the first rank's that has one) and its measure. Returns that cell on rank 0, -1 elsewhere.
+int agree_on_inverted(int bad_element, double& bad, bool& any) {
+  const double mine[2] = {static_cast<double>(bad_element), bad};
+  std::vector<double> all(2 * static_cast<std::size_t>(ranks::size()));
+  ranks::gather_to_root(mine, 2, all.data());
+  double verdict[2] = {-1, 0};
+  if (ranks::rank() == 0)
+    for (std::size_t r = 0; r < all.size(); r += 2)
+      if (all[r] >= 0) {
+        verdict[0] = all[r], verdict[1] = all[r + 1];
+        break;
+      }
+  ranks::broadcast(verdict, 2);
+  any = verdict[0] >= 0;
+  bad = verdict[1];
+  return ranks::rank() == 0 ? static_cast<int>(verdict[0]) : -1;
+}
+
+// Ranks > 0: their parts, by rank 0's id, with the linear system they fill.
+struct ServedPart {
+  std::unique_ptr<Part> part;
+  int system = -1;
+};
+std::map<int, ServedPart>& parts() {
+  static std::map<int, ServedPart> all;
+  return all;
+}
+
 // Ranks > 0: rank 0's commands of the distributed assembly.
 void serve_assembly(int command, int id) {
   if (command == ranks::kAssemblyDestroy) {
     replicas().erase(id);
+    parts().erase(id);
     return;
   }
   if (command == ranks::kAssemblyCreate) {
@@ -383,6 +527,16 @@ void serve_assembly(int command, int id) {
     std::string element;
     int threads = 1;
     broadcast_mesh(mesh, element, threads);
+    std::array<int, 6> info{};  // partitioned, the system's id, its layout
+    ranks::broadcast(info.data(), info.size());
+    if (info[0]) {
+      const int cells = mesh.cell_count();
+      parts()[id] = ServedPart{make_part(mesh, element, {info[2], info[3], info[4], info[5]},
+                                         cell_start(cells, ranks::size(), ranks::rank()),
+                                         cell_start(cells, ranks::size(), ranks::rank() + 1), threads),
+                               info[1]};
+      return;  // the whole mesh goes: this rank keeps its cells only
+    }
     Replica r;
     r.element = make_element(element, std::move(mesh));
     r.threads = threads;
@@ -390,6 +544,27 @@ void serve_assembly(int command, int id) {
     (void)r.cells.build(*r.element, layout.dofs);
     r.values.resize(r.cells.nonzeros);
     replicas()[id] = std::move(r);
+    return;
+  }
+  if (const auto it = parts().find(id); it != parts().end()) {
+    Part& part = *it->second.part;
+    if (command == ranks::kAssemblyReaction) {
+      Eigen::VectorXd U(part.unknowns), reaction = Eigen::VectorXd::Zero(part.unknowns);
+      ranks::broadcast(U.data(), static_cast<std::size_t>(U.size()));
+      add_part_reaction(part, U, reaction);
+      ranks::sum_to_root(reaction.data(), static_cast<std::size_t>(reaction.size()));
+      return;
+    }
+    AssemblyData d;
+    broadcast(d);
+    double bad = 0;
+    bool any = false;
+    agree_on_inverted(assemble_part(part, d, bad), bad, any);
+    if (any) return;
+    try {
+      ranks::fill_system(it->second.system, part.view(), {}, {}, {});
+    } catch (const std::runtime_error&) {  // rank 0 reports it
+    }
     return;
   }
   // kAssemble
@@ -412,7 +587,8 @@ void serve_assembly(int command, int id) {
 
 const bool assembly_served = ranks::on_command(ranks::kAssemblyCreate, serve_assembly) &&
                              ranks::on_command(ranks::kAssemble, serve_assembly) &&
-                             ranks::on_command(ranks::kAssemblyDestroy, serve_assembly);
+                             ranks::on_command(ranks::kAssemblyDestroy, serve_assembly) &&
+                             ranks::on_command(ranks::kAssemblyReaction, serve_assembly);
 
 }  // namespace
 
@@ -450,6 +626,18 @@ struct BasicFlowSolver<Dim>::Impl {
   }
   // The distributed assembly's id (-1: this rank assembles every cell).
   int distributed = -1;
+  // The partitioned assembly (3D): rank 0's own block of cells, and the linear system every rank
+  // fills (-1: the whole matrix is assembled here, by this rank or summed from the others').
+  std::unique_ptr<Part> part;
+  int system = -1;
+  bool partitioned() const { return system >= 0; }
+  // A cell's unknowns in the system (the pattern's, or the element's in the partitioned mode).
+  const int* unknowns_of(int e, std::vector<int>& scratch) const {
+    if (!partitioned()) return cells.dofs_of(e);
+    scratch.resize(static_cast<std::size_t>(element->local_size()));
+    element->element_dofs(e, scratch.data());
+    return scratch.data();
+  }
   ~Impl() {
     if (distributed >= 0) ranks::command(ranks::kAssemblyDestroy, distributed);
   }
@@ -465,10 +653,19 @@ struct BasicFlowSolver<Dim>::Impl {
       std::string name = element->name();
       int threads = std::max(1, params.threads);
       broadcast_mesh(copy, name, threads);
+      const int target = params.partitioned_assembly ? lu->partition_id() : -1;
+      const auto whole = layout_numbers(dof);
+      std::array<int, 6> info{target >= 0, target, whole[0], whole[1], whole[2], whole[3]};
+      ranks::broadcast(info.data(), info.size());
+      if (target >= 0) {
+        part = make_part(mesh(), name, whole, 0, cell_start(mesh().cell_count(), ranks::size(), 1), threads);
+        system = target;
+      }
       distributed = id;
-      fsi::logger("fluid")->info("assembly: {} cells over {} MPI ranks ({} to {} cells each)", mesh().cell_count(),
+      fsi::logger("fluid")->info("assembly: {} cells over {} MPI ranks ({} to {} cells each){}", mesh().cell_count(),
                                  ranks::size(), mesh().cell_count() / ranks::size(),
-                                 cell_start(mesh().cell_count(), ranks::size(), 1));
+                                 cell_start(mesh().cell_count(), ranks::size(), 1),
+                                 partitioned() ? "; partitioned: each rank keeps its cells and fills its rows" : "");
     } else {
       (void)params;
     }
@@ -485,6 +682,12 @@ struct BasicFlowSolver<Dim>::Impl {
       const auto kernel = kernel_parameters(in.params);
       std::copy(kernel.begin(), kernel.end(), d.scalars.begin() + 2);
       broadcast(d);
+      if (partitioned()) {
+        // rhs_volume keeps rank 0's loads only (the pressure boundaries): the reactions' share
+        rhs_volume = Eigen::VectorXd::Zero(dof.dofs);
+        bool any = false;
+        return agree_on_inverted(assemble_part(*part, d, bad), bad, any);
+      }
       const int e =
           cells.assemble(in, 0, cell_start(all, ranks::size(), 1), nthreads, volume.valuePtr(), rhs_volume, bad);
       return reduce_parts(volume.valuePtr(), cells.nonzeros, rhs_volume, e, bad);
@@ -516,7 +719,7 @@ BasicFlowSolver<Dim>::BasicFlowSolver(Mesh mesh, FlowParameters params, const st
   for (int v = 0; v < im.mesh().vertices(); ++v) pressure[static_cast<std::size_t>(im.dof.pressure(v))] = 1;
   im.lu = make_linear_solver(params_, Dim, std::move(pressure));
   im.distribute(params_);  // first: the other ranks build their patterns while this one builds its own
-  im.build_pattern();
+  if (!im.partitioned()) im.build_pattern();
   U_ = U_n_ = U_nm1_ = reaction_ = Eigen::VectorXd::Zero(im.dof.dofs);
   X_ = X_n_ = X_nm1_ = im.mesh().nodes;
   interface_segments_.resize(0, 2);
@@ -738,9 +941,15 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
     Eigen::VectorXd load;
     for (const auto& t : c.traces) {
       im.element->pressure_load(t, X_, p, load);
-      const int* d = im.dofs_of(t.element);
+      std::vector<int> scratch;
+      const int* d = im.unknowns_of(t.element, scratch);
       for (Eigen::Index i = 0; i < load.size(); ++i) im.rhs_volume(d[i]) += load(i);
     }
+  }
+  if (im.partitioned()) {
+    fill_partitioned(step);
+    report.assembly_seconds += seconds_since(t_assembly);
+    return;
   }
   std::copy(im.volume.valuePtr(), im.volume.valuePtr() + im.volume.nonZeros(), im.matrix.valuePtr());
   im.rhs = im.rhs_volume;
@@ -773,6 +982,71 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
   report.assembly_seconds += seconds_since(t_assembly);
 }
 
+// The partitioned assembly's system: every rank's cells (in the distributed matrix already at
+// the ranks' fill), and from this rank the loads, the interface terms and the constraints.
+template <int Dim>
+void BasicFlowSolver<Dim>::fill_partitioned(const Step& step) {
+  auto& im = *impl_;
+  const int sys = im.system;
+  auto extras = [&] {
+    std::vector<int> rows;
+    std::vector<double> values;
+    for (Eigen::Index i = 0; i < im.rhs_volume.size(); ++i)
+      if (im.rhs_volume(i) != 0) rows.push_back(static_cast<int>(i)), values.push_back(im.rhs_volume(i));
+    ranks::add_to_rhs(sys, static_cast<int>(rows.size()), rows.data(), values.data());
+    if (step.robin) {
+      const RobinCondition& r = *step.robin;
+      std::vector<Eigen::Triplet<double>> t;
+      for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
+      Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
+      for (const auto& e : t) lumped(e.row()) += e.value();
+      for (Eigen::Index j = 0; j < lumped.size(); ++j) {
+        const double a = r.coefficient(j) * lumped(j);
+        for (int c = 0; c < Dim; ++c) {
+          const int k = im.dof.velocity(interface_nodes_[static_cast<std::size_t>(j)], c);
+          const double b = a * r.velocity(Dim * j + c) + r.traction(Dim * j + c);
+          ranks::add_to_system(sys, 1, &k, 1, &k, &a);
+          ranks::add_to_rhs(sys, 1, &k, &b);
+        }
+      }
+    } else {
+      const detail::NitscheInputT<Dim> nitsche{X_, penalty_positions(), interface_velocity_, params_};
+      detail::LocalSystem s;
+      std::vector<int> scratch;
+      for (const auto& edge : im.edges) {
+        im.element->nitsche(edge, nitsche, s);
+        const int* d = im.unknowns_of(edge.element, scratch);
+        const auto n = static_cast<int>(s.rhs.size());
+        ranks::add_to_system(sys, n, d, n, d, s.matrix.data());
+        ranks::add_to_rhs(sys, n, d, s.rhs.data());
+      }
+    }
+  };
+  std::vector<int> rows;
+  std::vector<double> values;
+  for (std::size_t i = 0; i < step.constraints.on.size(); ++i)
+    if (step.constraints.on[i])
+      rows.push_back(static_cast<int>(i)), values.push_back(step.constraints.value(static_cast<Eigen::Index>(i)));
+  try {
+    ranks::fill_system(sys, im.part->view(), extras, rows, values);
+  } catch (const std::runtime_error& e) {
+    throw SolverError(
+        fmt::format("fluid step at t = {:.6g}: filling the distributed matrix failed: {}", step.time, e.what()));
+  }
+}
+
+// The reactions K_vol U - F_vol of the partitioned assembly: every rank's cells' share, summed here.
+template <int Dim>
+Eigen::VectorXd BasicFlowSolver<Dim>::partitioned_reaction() {
+  auto& im = *impl_;
+  ranks::command(ranks::kAssemblyReaction, im.distributed);
+  Eigen::VectorXd U = U_, reaction = Eigen::VectorXd::Zero(im.dof.dofs);
+  ranks::broadcast(U.data(), static_cast<std::size_t>(U.size()));
+  if constexpr (Dim == 3) add_part_reaction(*im.part, U, reaction);
+  ranks::sum_to_root(reaction.data(), static_cast<std::size_t>(reaction.size()));
+  return reaction - im.rhs_volume;
+}
+
 template <int Dim>
 StepReport BasicFlowSolver<Dim>::solve(double time, double dt, const Nodes& positions,
                                        const Eigen::VectorXd& interface_velocity) {
@@ -803,9 +1077,10 @@ StepReport BasicFlowSolver<Dim>::solve(Step& step) {
   double previous_change = std::numeric_limits<double>::infinity();
   for (int iteration = 1; iteration <= std::max(1, params_.max_iterations); ++iteration) {
     assemble(step, U_lin, report);
-    Eigen::VectorXd U_new =
-        im.lu->solve(im.matrix, im.rhs, step.retrial ? U_ : U_lin, report,
-                     fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration), step.alpha0_dt);
+    const auto where = fmt::format("fluid step at t = {:.6g}, iteration {}", time, iteration);
+    const Eigen::VectorXd& guess = step.retrial ? U_ : U_lin;
+    Eigen::VectorXd U_new = im.partitioned() ? im.lu->solve_filled(im.dof.dofs, guess, report, where, step.alpha0_dt)
+                                             : im.lu->solve(im.matrix, im.rhs, guess, report, where, step.alpha0_dt);
     double change = relative_velocity_change<Dim>(U_new, U_lin, mesh().node_count(), im.dof);
     // Damped Newton (P2/P1): an update that grows the change is halved (iterations 3 on, so
     // the first Oseen/Stokes solve and the first Newton correction are always taken whole).
@@ -818,7 +1093,7 @@ StepReport BasicFlowSolver<Dim>::solve(Step& step) {
     report.iterations = iteration;
     U_ = U_new;
     U_lin = U_new;
-    reaction_ = im.volume * U_ - im.rhs_volume;
+    reaction_ = im.partitioned() ? partitioned_reaction() : Eigen::VectorXd(im.volume * U_ - im.rhs_volume);
     if (observer_) observer_(iteration, change);
     if (report.change < params_.tolerance) break;
   }

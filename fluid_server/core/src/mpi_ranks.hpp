@@ -6,12 +6,14 @@
 // same collective calls below, in the same order. Implemented in petsc_solver.cpp (the one
 // source that sees MPI); a build without PETSc has one rank and every call is a no-op.
 #include <cstddef>
+#include <functional>
 #include <string>
+#include <vector>
 
 namespace fsi::fluid::ranks {
 
 // Commands other than the linear solver's (which uses 0-3).
-enum Command : int { kAssemblyCreate = 16, kAssemble = 17, kAssemblyDestroy = 18 };
+enum Command : int { kAssemblyCreate = 16, kAssemble = 17, kAssemblyDestroy = 18, kAssemblyReaction = 19 };
 
 // Ranks > 0: the function called for `command` (with rank 0's id). Register before serving
 // (at static initialisation of the registering source).
@@ -34,5 +36,32 @@ void broadcast(std::string& text);
 void sum_to_root(double* data, std::size_t count);
 // Collective: rank 0 gets every rank's `count` values in rank order in `all` (size() * count).
 void gather_to_root(const double* mine, int count, double* all);
+
+// ---- A linear system distributed by rows, filled by every rank (the partitioned assembly) ----
+// `id`: the PETSc solver's (LinearSolver::partition_id).
+
+// One rank's part of the matrix and right-hand side: a square matrix on the rank's own unknowns
+// (CSC with local indices) and the map from its local unknowns to the system's.
+struct Part {
+  int unknowns = 0;  // of the whole system
+  int columns = 0;   // local unknowns
+  const int* colptr = nullptr;
+  const int* rowind = nullptr;
+  const double* values = nullptr;
+  const int* global = nullptr;  // local unknown -> the system's
+  const double* rhs = nullptr;  // per local unknown
+};
+
+// Collective: the system's matrix and right-hand side become the sum of every rank's part and of
+// what `extras` (called on rank 0 only) adds; then the rows `rows` (rank 0's list; the others
+// pass none) become identity rows with right-hand side `values`. The first call (and one with
+// another number of unknowns) takes the pattern from the parts. Throws std::runtime_error with
+// PETSc's message on a failure (every rank alike).
+void fill_system(int id, const Part& part, const std::function<void()>& extras, const std::vector<int>& rows,
+                 const std::vector<double>& values);
+// Rank 0, inside `extras`: a dense m x n block (column-major) at the rows and columns given, and
+// right-hand side entries, added (indices of the whole system, inside the parts' pattern).
+void add_to_system(int id, int m, const int* rows, int n, const int* cols, const double* block);
+void add_to_rhs(int id, int m, const int* rows, const double* values);
 
 }  // namespace fsi::fluid::ranks

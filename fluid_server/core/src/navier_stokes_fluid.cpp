@@ -157,7 +157,9 @@ void read_linear_solver(const schema::Reader& section, bool taylor_hood, int dim
   params.engine = dimension == 3 && petsc_available() ? LinearEngine::Petsc : LinearEngine::Umfpack;
   const int ranks = section.get<int>("ranks");
   // fluid.mpi: the launcher's keys (fsi run), and how the ranks share the assembly.
-  params.distributed_assembly = section.child_or_defaults("mpi").get<std::string>("assembly") == "distributed";
+  const auto assembly = section.child_or_defaults("mpi").get<std::string>("assembly");
+  params.distributed_assembly = assembly != "rank0";
+  params.partitioned_assembly = assembly == "partitioned";
   if (ranks != mpi_world_size())
     section.fail("ranks", fmt::format("is {} but this fluid_server runs on {} MPI rank(s): fsi run starts it under "
                                       "mpirun -n {} (or start it so yourself)",

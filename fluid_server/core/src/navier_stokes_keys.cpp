@@ -70,10 +70,12 @@ const std::vector<schema::Key>& navier_stokes_keys() {
               text("command", "the MPI launcher (PATH is searched)").def("mpirun"),
               text("hostfile", "mpirun --hostfile: the hosts of the ranks (relative to the scene file)"),
               string_list("args", "further launcher arguments, e.g. [--oversubscribe] or [--host, a:2,b:2]").def("[]"),
-              choice("assembly", {"distributed", "rank0"},
-                     "3D: distributed = every rank computes the element matrices of its block of cells and rank 0 "
-                     "sums them; rank0 = rank 0 assembles alone (2D always does)")
-                  .def("distributed"),
+              choice("assembly", {"partitioned", "distributed", "rank0"},
+                     "3D: partitioned = each rank keeps only its block of cells and adds their element matrices to "
+                     "its rows of the distributed matrix; distributed = every rank computes the element matrices "
+                     "of its block and rank 0 sums them into the whole matrix; rank0 = rank 0 assembles alone (2D "
+                     "always does)")
+                  .def("partitioned"),
           }),
       integer("umfpack_irstep", "UMFPACK iterative refinement steps").def("0").ge(0).le(2),
       section("linear_solver",

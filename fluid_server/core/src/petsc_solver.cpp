@@ -108,6 +108,7 @@ struct Header {
   int has_guess = 0;
   int check_options = 0;
   int max_it = 0;  // > 0: the iteration limit of a solve with a kept preconditioner
+  int filled = 0;  // the ranks filled the matrix and rhs (fill); only the guess comes from rank 0
 };
 
 }  // namespace
@@ -120,14 +121,7 @@ class PetscSystem {
       : prefix_(std::move(prefix)), user_options_(std::move(user_options)), pressure_(std::move(pressure)) {
     FSI_PETSC(PetscOptionsInsertString(nullptr, options.c_str()));
   }
-  ~PetscSystem() {
-    if (ksp_) KSPDestroy(&ksp_);
-    if (A_) MatDestroy(&A_);
-    if (x_) VecDestroy(&x_);
-    if (b_) VecDestroy(&b_);
-    if (is_u_) ISDestroy(&is_u_);
-    if (is_p_) ISDestroy(&is_p_);
-  }
+  ~PetscSystem() { release(); }
   PetscSystem(const PetscSystem&) = delete;
   PetscSystem& operator=(const PetscSystem&) = delete;
 
@@ -149,7 +143,10 @@ class PetscSystem {
     Outcome out;
     MPI_Bcast(&h, sizeof(Header), MPI_BYTE, 0, PETSC_COMM_WORLD);
     try {
-      distribute(h, A, b, guess);
+      if (h.filled)
+        take_guess(h, guess);
+      else
+        distribute(h, A, b, guess);
       const auto t_setup = Clock::now();
       if (h.new_pattern || !ksp_) build_ksp();
       FSI_PETSC(KSPSetOperators(ksp_, A_, A_));
@@ -206,7 +203,123 @@ class PetscSystem {
     return kt && std::string(kt) == KSPPREONLY;
   }
 
+  // Collective (mpi_ranks.hpp, fill_system): A and b from every rank's part, rank 0's extras,
+  // then the constrained rows.
+  void fill(const ranks::Part& part, const std::function<void()>& extras, const std::vector<int>& rows,
+            const std::vector<double>& values) {
+    if (!A_ || !filled_ || n_ != part.unknowns) create_filled(part);
+    FSI_PETSC(MatZeroEntries(A_));
+    FSI_PETSC(VecZeroEntries(b_));
+    add_part(A_, part, true);
+    FSI_PETSC(VecSetValues(b_, part.columns, part.global, part.rhs, ADD_VALUES));
+    if (g_rank == 0) extras();
+    FSI_PETSC(MatAssemblyBegin(A_, MAT_FINAL_ASSEMBLY));
+    FSI_PETSC(MatAssemblyEnd(A_, MAT_FINAL_ASSEMBLY));
+    FSI_PETSC(VecAssemblyBegin(b_));
+    FSI_PETSC(VecAssemblyEnd(b_));
+    // Identity rows, rhs the value: MatZeroRows sets b = x on them.
+    const auto count = static_cast<PetscInt>(rows.size());
+    FSI_PETSC(VecSet(x_, 0.0));
+    if (count > 0) FSI_PETSC(VecSetValues(x_, count, rows.data(), values.data(), INSERT_VALUES));
+    FSI_PETSC(VecAssemblyBegin(x_));
+    FSI_PETSC(VecAssemblyEnd(x_));
+    FSI_PETSC(MatZeroRows(A_, count, rows.data(), 1.0, x_, b_));
+  }
+  void add_block(int m, const int* rows, int n, const int* cols, const double* block) {
+    FSI_PETSC(MatSetOption(A_, MAT_ROW_ORIENTED, PETSC_FALSE));
+    FSI_PETSC(MatSetValues(A_, m, rows, n, cols, block, ADD_VALUES));
+    FSI_PETSC(MatSetOption(A_, MAT_ROW_ORIENTED, PETSC_TRUE));
+  }
+  void add_rhs(int m, const int* rows, const double* values) {
+    FSI_PETSC(VecSetValues(b_, m, rows, values, ADD_VALUES));
+  }
+
  private:
+  bool filled_ = false;
+  std::vector<PetscInt> column_rows_;  // scratch: one column's rows in the system's numbering
+
+  // The part's columns into M (values, or zeros for the preallocator).
+  void add_part(Mat M, const ranks::Part& part, bool values) {
+    std::vector<PetscScalar> zeros;
+    for (int j = 0; j < part.columns; ++j) {
+      const int first = part.colptr[j], count = part.colptr[j + 1] - first;
+      column_rows_.resize(static_cast<std::size_t>(count));
+      for (int k = 0; k < count; ++k) column_rows_[static_cast<std::size_t>(k)] = part.global[part.rowind[first + k]];
+      const PetscInt col = part.global[j];
+      if (!values) zeros.assign(static_cast<std::size_t>(count), 0.0);
+      FSI_PETSC(MatSetValues(M, count, column_rows_.data(), 1, &col, values ? part.values + first : zeros.data(),
+                             ADD_VALUES));
+    }
+  }
+
+  // The matrix of a filled system: rows in blocks over the ranks, preallocated from the union of
+  // the parts' patterns (MATPREALLOCATOR); the pattern is kept by every later fill.
+  void create_filled(const ranks::Part& part) {
+    release();
+    n_ = part.unknowns;
+    set_layout();
+    const PetscInt local = end_ - start_;
+    Mat P = nullptr;
+    FSI_PETSC(MatCreate(PETSC_COMM_WORLD, &P));
+    FSI_PETSC(MatSetSizes(P, local, local, n_, n_));
+    FSI_PETSC(MatSetType(P, MATPREALLOCATOR));
+    FSI_PETSC(MatSetUp(P));
+    add_part(P, part, false);
+    FSI_PETSC(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
+    FSI_PETSC(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+    FSI_PETSC(MatCreate(PETSC_COMM_WORLD, &A_));
+    FSI_PETSC(MatSetSizes(A_, local, local, n_, n_));
+    FSI_PETSC(MatSetType(A_, MATAIJ));
+    FSI_PETSC(MatPreallocatorPreallocate(P, PETSC_TRUE, A_));
+    MatDestroy(&P);
+    FSI_PETSC(MatSetOption(A_, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
+    FSI_PETSC(MatSetOption(A_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+    make_vectors();
+    filled_ = true;
+  }
+
+  // Rank 0's guess into x.
+  void take_guess(const Header& h, const Eigen::VectorXd* guess) {
+    if (!h.has_guess) return;
+    const int local = static_cast<int>(end_ - start_);
+    guess_.resize(static_cast<std::size_t>(local));
+    MPI_Scatterv(g_rank == 0 ? guess->data() : nullptr, counts_.data(), displs_.data(), MPI_DOUBLE, guess_.data(),
+                 local, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+    copy_in(x_, guess_);
+  }
+
+  void release() {
+    if (ksp_) KSPDestroy(&ksp_);
+    if (A_) MatDestroy(&A_);
+    if (x_) VecDestroy(&x_);
+    if (b_) VecDestroy(&b_);
+    if (is_u_) ISDestroy(&is_u_);
+    if (is_p_) ISDestroy(&is_p_);
+    filled_ = false;
+  }
+
+  // Rows [start_, end_) of n_ on this rank; the per-rank counts for scatters and gathers.
+  void set_layout() {
+    const int size = g_size;
+    counts_.assign(static_cast<std::size_t>(size), 0);
+    displs_.assign(static_cast<std::size_t>(size), 0);
+    for (int r = 0; r < size; ++r) {
+      displs_[static_cast<std::size_t>(r)] = static_cast<int>(row_start(n_, size, r));
+      counts_[static_cast<std::size_t>(r)] = static_cast<int>(row_start(n_, size, r + 1) - row_start(n_, size, r));
+    }
+    start_ = row_start(n_, size, g_rank);
+    end_ = row_start(n_, size, g_rank + 1);
+  }
+
+  // x, b and the velocity / pressure index sets of A's rows.
+  void make_vectors() {
+    FSI_PETSC(MatCreateVecs(A_, &x_, &b_));
+    std::vector<PetscInt> u, p;
+    for (PetscInt i = start_; i < end_; ++i) (pressure_[static_cast<std::size_t>(i)] ? p : u).push_back(i);
+    FSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, static_cast<PetscInt>(u.size()), u.data(), PETSC_COPY_VALUES, &is_u_));
+    FSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, static_cast<PetscInt>(p.size()), p.data(), PETSC_COPY_VALUES, &is_p_));
+  }
+
   std::string prefix_;
   std::vector<std::string> user_options_;
   std::vector<char> pressure_;
@@ -222,16 +335,9 @@ class PetscSystem {
   void distribute(const Header& h, const Eigen::SparseMatrix<double, Eigen::RowMajor>* A, const Eigen::VectorXd* b,
                   const Eigen::VectorXd* guess) {
     const int size = g_size, rank = g_rank;
-    if (h.new_pattern || !A_) {
+    if (h.new_pattern || !A_ || filled_) {
       n_ = h.n;
-      counts_.assign(static_cast<std::size_t>(size), 0);
-      displs_.assign(static_cast<std::size_t>(size), 0);
-      for (int r = 0; r < size; ++r) {
-        displs_[static_cast<std::size_t>(r)] = static_cast<int>(row_start(n_, size, r));
-        counts_[static_cast<std::size_t>(r)] = static_cast<int>(row_start(n_, size, r + 1) - row_start(n_, size, r));
-      }
-      start_ = row_start(n_, size, rank);
-      end_ = row_start(n_, size, rank + 1);
+      set_layout();
       const int local = static_cast<int>(end_ - start_);
       // Row lengths, then the column indices.
       std::vector<int> lengths;
@@ -272,25 +378,14 @@ class PetscSystem {
       MPI_Scatterv(rank == 0 ? guess->data() : nullptr, counts_.data(), displs_.data(), MPI_DOUBLE, guess_.data(),
                    local, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
 
-    if (h.new_pattern || !A_) {
-      if (ksp_) KSPDestroy(&ksp_);
-      if (A_) MatDestroy(&A_);
-      if (x_) VecDestroy(&x_);
-      if (b_) VecDestroy(&b_);
-      if (is_u_) ISDestroy(&is_u_);
-      if (is_p_) ISDestroy(&is_p_);
+    if (h.new_pattern || !A_ || filled_) {
+      release();
       FSI_PETSC(MatCreate(PETSC_COMM_WORLD, &A_));
       FSI_PETSC(MatSetSizes(A_, local, local, n_, n_));
       FSI_PETSC(MatSetType(A_, MATAIJ));
       FSI_PETSC(MatSeqAIJSetPreallocationCSR(A_, rowptr_.data(), cols_.data(), values_.data()));
       FSI_PETSC(MatMPIAIJSetPreallocationCSR(A_, rowptr_.data(), cols_.data(), values_.data()));
-      FSI_PETSC(MatCreateVecs(A_, &x_, &b_));
-      std::vector<PetscInt> u, p;
-      for (PetscInt i = start_; i < end_; ++i) (pressure_[static_cast<std::size_t>(i)] ? p : u).push_back(i);
-      FSI_PETSC(
-          ISCreateGeneral(PETSC_COMM_WORLD, static_cast<PetscInt>(u.size()), u.data(), PETSC_COPY_VALUES, &is_u_));
-      FSI_PETSC(
-          ISCreateGeneral(PETSC_COMM_WORLD, static_cast<PetscInt>(p.size()), p.data(), PETSC_COPY_VALUES, &is_p_));
+      make_vectors();
     } else {
       for (int i = 0; i < local; ++i) {
         const PetscInt row = start_ + i;
@@ -396,6 +491,23 @@ std::string prefixed(const std::string& options, const std::string& prefix) {
 std::map<int, std::unique_ptr<PetscSystem>>& served() {
   static std::map<int, std::unique_ptr<PetscSystem>> systems;
   return systems;
+}
+
+// Rank 0: its own systems, by id (the PetscSolvers own them).
+std::map<int, PetscSystem*>& own() {
+  static std::map<int, PetscSystem*> systems;
+  return systems;
+}
+
+PetscSystem& system_of(int id) {
+  if (g_rank == 0) {
+    if (const auto it = own().find(id); it != own().end()) return *it->second;
+  } else if (const auto it = served().find(id); it != served().end()) {
+    return *it->second;
+  }
+  std::fprintf(stderr, "fluid_server rank %d: an unknown linear system %d\n", g_rank, id);
+  MPI_Abort(PETSC_COMM_WORLD, 3);
+  std::abort();
 }
 
 struct CreateMessage {
@@ -528,6 +640,7 @@ PetscSolver::PetscSolver(const FlowParameters& params, std::vector<char> pressur
   } catch (const PetscFailure& e) {
     throw std::invalid_argument(fmt::format("fluid.linear_solver.petsc_options: {}", e.what()));
   }
+  own()[s.id] = s.system.get();
 }
 
 PetscSolver::~PetscSolver() {
@@ -535,30 +648,49 @@ PetscSolver::~PetscSolver() {
   PetscBool down = PETSC_FALSE;
   PetscFinalized(&down);
   if (down) {
+    own().erase(impl_->id);
     (void)impl_->system.release();  // PETSc is gone with its objects
     return;
   }
   send_command(kDestroy, impl_->id);  // first: destroying the objects is collective
+  own().erase(impl_->id);
   impl_->system.reset();
 }
 
 Eigen::VectorXd PetscSolver::solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                                    const Eigen::VectorXd& guess, StepReport& report, const std::string& where,
                                    double time_coefficient) {
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = A;
+  return run(A.rows(), A.nonZeros(), &rows, &b, guess, report, where, time_coefficient);
+}
+
+Eigen::VectorXd PetscSolver::solve_filled(int unknowns, const Eigen::VectorXd& guess, StepReport& report,
+                                          const std::string& where, double time_coefficient) {
+  return run(unknowns, -1, nullptr, nullptr, guess, report, where, time_coefficient);
+}
+
+int PetscSolver::partition_id() const { return g_size > 1 ? impl_->id : -1; }
+
+// `rows` null: the ranks filled the system (fill_system); `nonzeros` -1 then (the pattern is the
+// filled matrix's, new when the number of unknowns changes).
+Eigen::VectorXd PetscSolver::run(Eigen::Index unknowns, Eigen::Index nonzeros,
+                                 const Eigen::SparseMatrix<double, Eigen::RowMajor>* rows, const Eigen::VectorXd* b,
+                                 const Eigen::VectorXd& guess, StepReport& report, const std::string& where,
+                                 double time_coefficient) {
   auto& s = *impl_;
   Header h;
-  h.n = static_cast<int>(A.rows());
-  h.new_pattern = !s.have_pattern || A.rows() != s.rows || A.nonZeros() != s.nonzeros;
-  h.has_guess = guess.size() == b.size();
+  h.n = static_cast<int>(unknowns);
+  h.filled = rows == nullptr;
+  h.new_pattern = !s.have_pattern || unknowns != s.rows || nonzeros != s.nonzeros;
+  h.has_guess = guess.size() == unknowns;
   h.check_options = !s.options_checked;
   if (h.new_pattern || time_coefficient != s.time_coefficient) s.have_pc = false;
   h.reuse = s.params.petsc_reuse_preconditioner && s.have_pc && !s.system->preonly();
   // A kept preconditioner gets as many iterations as the rebuild rule allows; beyond, a fresh one.
   if (h.reuse) h.max_it = static_cast<int>(std::ceil(s.params.petsc_rebuild_factor * s.pc_iterations)) + 5;
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = A;
   Eigen::VectorXd x;
   send_command(kSolve, s.id);
-  const auto outcome = s.system->solve(h, &rows, &b, h.has_guess ? &guess : nullptr, &x);
+  const auto outcome = s.system->solve(h, rows, b, h.has_guess ? &guess : nullptr, &x);
   if (!outcome.error.empty()) {
     s.have_pattern = false;
     s.have_pc = false;
@@ -566,8 +698,8 @@ Eigen::VectorXd PetscSolver::solve(const Eigen::SparseMatrix<double>& A, const E
         fmt::format("{}: the PETSc solve ({}) failed: {}", where, engine_name(s.params.engine), outcome.error));
   }
   s.have_pattern = true;
-  s.rows = A.rows();
-  s.nonzeros = A.nonZeros();
+  s.rows = unknowns;
+  s.nonzeros = nonzeros;
   s.time_coefficient = time_coefficient;
   if (h.check_options) {
     s.options_checked = true;
@@ -583,7 +715,7 @@ Eigen::VectorXd PetscSolver::solve(const Eigen::SparseMatrix<double>& A, const E
   if (!s.logged) {
     s.logged = true;
     fsi::logger("fluid")->info("linear solver: PETSc ({}) on {} rank(s), {}, {} unknowns; first solve {} iterations",
-                               engine_name(s.params.engine), g_size, outcome.description, A.rows(), outcome.iterations);
+                               engine_name(s.params.engine), g_size, outcome.description, unknowns, outcome.iterations);
   }
   report.krylov_iterations += outcome.iterations;
   report.factor_seconds += outcome.setup_seconds;
@@ -660,6 +792,22 @@ void sum_to_root(double* data, std::size_t count) {
 void gather_to_root(const double* mine, int count, double* all) {
   MPI_Gather(mine, count, MPI_DOUBLE, all, count, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
 }
+
+void fill_system(int id, const Part& part, const std::function<void()>& extras, const std::vector<int>& rows,
+                 const std::vector<double>& values) {
+  static_assert(sizeof(PetscInt) == sizeof(int), "PETSc with 32-bit indices");
+  try {
+    system_of(id).fill(part, extras, rows, values);
+  } catch (const PetscFailure& e) {
+    throw std::runtime_error(e.what());
+  }
+}
+
+void add_to_system(int id, int m, const int* rows, int n, const int* cols, const double* block) {
+  system_of(id).add_block(m, rows, n, cols, block);
+}
+
+void add_to_rhs(int id, int m, const int* rows, const double* values) { system_of(id).add_rhs(m, rows, values); }
 
 }  // namespace ranks
 

@@ -16,11 +16,18 @@ class PetscSolver final : public LinearSolver {
   ~PetscSolver() override;
   Eigen::VectorXd solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b, const Eigen::VectorXd& guess,
                         StepReport& report, const std::string& where, double time_coefficient) override;
+  int partition_id() const override;
+  Eigen::VectorXd solve_filled(int unknowns, const Eigen::VectorXd& guess, StepReport& report, const std::string& where,
+                               double time_coefficient) override;
   void discard_factors() override;
   void save_state(StateArchive& state, const std::string& prefix) const override;
   void load_state(const StateArchive& state, const std::string& prefix) override;
 
  private:
+  Eigen::VectorXd run(Eigen::Index unknowns, Eigen::Index nonzeros,
+                      const Eigen::SparseMatrix<double, Eigen::RowMajor>* rows, const Eigen::VectorXd* b,
+                      const Eigen::VectorXd& guess, StepReport& report, const std::string& where,
+                      double time_coefficient);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -136,8 +136,11 @@ struct FlowParameters {
   bool petsc_reuse_preconditioner = true;
   double petsc_rebuild_factor = 1.5;
   // PETSc engines on several MPI ranks, 3D: every rank computes the element matrices of its
-  // block of cells and rank 0 sums them (false: rank 0 assembles alone, as 2D always does).
+  // block of cells (false: rank 0 assembles alone, as 2D always does). Partitioned: each rank
+  // keeps only its cells (a mesh of their own) and adds their matrices straight into the
+  // distributed matrix; otherwise rank 0 sums the blocks into the whole matrix.
   bool distributed_assembly = true;
+  bool partitioned_assembly = true;
   // Tests only (the GCL tests' control): the ALE mesh velocity is multiplied by this; anything
   // but 1 is a wrong mesh velocity, which a GCL test must detect.
   double mesh_velocity_scale = 1.0;
@@ -247,7 +250,8 @@ class BasicFlowSolver {
   // distributed_assembly).
   int assembly_ranks() const;
   const Eigen::VectorXd& reaction() const { return reaction_; }  // K_vol U - F_vol, every unknown
-  // The system of the last solve (constraints applied) and its right-hand side (benchmarks).
+  // The system of the last solve (constraints applied) and its right-hand side (benchmarks; empty
+  // with the partitioned assembly on several ranks, where no rank holds the whole matrix).
   const Eigen::SparseMatrix<double>& last_matrix() const;
   const Eigen::VectorXd& last_rhs() const;
   Nodes velocity() const;            // per node
@@ -299,6 +303,8 @@ class BasicFlowSolver {
   Step begin_step(double time, double dt, const Nodes& positions, const Eigen::VectorXd& interface_velocity);
   StepReport solve(Step& step);
   void assemble(const Step& step, const Eigen::VectorXd& U_lin, StepReport& report);
+  void fill_partitioned(const Step& step);  // 3D on several ranks (FlowParameters::partitioned_assembly)
+  Eigen::VectorXd partitioned_reaction();
   bool locate(const PointD& point, int& element, Eigen::Matrix<double, Dim + 1, 1>& bary) const;
 };
 

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,15 @@ class LinearSolver {
   virtual Eigen::VectorXd solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                                 const Eigen::VectorXd& guess, StepReport& report, const std::string& where,
                                 double time_coefficient) = 0;
+  // The PETSc engines on several MPI ranks: the id by which every rank fills this solver's
+  // distributed matrix itself (the partitioned assembly, mpi_ranks.hpp's fill_system), or -1.
+  virtual int partition_id() const { return -1; }
+  // Solves the system the ranks filled last (partition_id() >= 0; `unknowns` of it), as solve().
+  virtual Eigen::VectorXd solve_filled(int unknowns, const Eigen::VectorXd& guess, StepReport& report,
+                                       const std::string& where, double time_coefficient) {
+    (void)unknowns, (void)guess, (void)report, (void)time_coefficient;
+    throw std::logic_error(where + ": this linear solver has no distributed matrix");
+  }
   // Checkpoints: the next solve sets up afresh; the state of the engine's decisions.
   virtual void discard_factors() = 0;
   virtual void save_state(StateArchive& state, const std::string& prefix) const = 0;
