@@ -509,6 +509,10 @@ int agree_on_inverted(int bad_element, double& bad, bool& any) {
 struct ServedPart {
   std::unique_ptr<Part> part;
   int system = -1;
+  struct Extras {  // rank 0's own entries of the system (fill_partitioned)
+    std::vector<int> rows, cols, rhs_rows;
+    std::vector<double> values, rhs_values;
+  } extras;
 };
 std::map<int, ServedPart>& parts() {
   static std::map<int, ServedPart> all;
@@ -562,7 +566,7 @@ void serve_assembly(int command, int id) {
     agree_on_inverted(assemble_part(part, d, bad), bad, any);
     if (any) return;
     try {
-      ranks::fill_system(it->second.system, part.view(), {}, {}, {});
+      ranks::fill_system(it->second.system, part.view(), {}, {});
     } catch (const std::runtime_error&) {  // rank 0 reports it
     }
     return;
@@ -630,6 +634,10 @@ struct BasicFlowSolver<Dim>::Impl {
   // fills (-1: the whole matrix is assembled here, by this rank or summed from the others').
   std::unique_ptr<Part> part;
   int system = -1;
+  struct Extras {  // rank 0's own entries of the system (fill_partitioned)
+    std::vector<int> rows, cols, rhs_rows;
+    std::vector<double> values, rhs_values;
+  } extras;
   bool partitioned() const { return system >= 0; }
   // A cell's unknowns in the system (the pattern's, or the element's in the partitioned mode).
   const int* unknowns_of(int e, std::vector<int>& scratch) const {
@@ -982,53 +990,70 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
   report.assembly_seconds += seconds_since(t_assembly);
 }
 
-// The partitioned assembly's system: every rank's cells (in the distributed matrix already at
-// the ranks' fill), and from this rank the loads, the interface terms and the constraints.
+// The partitioned assembly's system: every rank's cells, and from this rank the loads, the
+// interface terms and the constraints. The interface entries' pattern is every interface face's
+// cell block and the interface velocities' diagonal (Nitsche or Robin: one pattern for both).
 template <int Dim>
 void BasicFlowSolver<Dim>::fill_partitioned(const Step& step) {
   auto& im = *impl_;
-  const int sys = im.system;
-  auto extras = [&] {
-    std::vector<int> rows;
-    std::vector<double> values;
-    for (Eigen::Index i = 0; i < im.rhs_volume.size(); ++i)
-      if (im.rhs_volume(i) != 0) rows.push_back(static_cast<int>(i)), values.push_back(im.rhs_volume(i));
-    ranks::add_to_rhs(sys, static_cast<int>(rows.size()), rows.data(), values.data());
-    if (step.robin) {
-      const RobinCondition& r = *step.robin;
-      std::vector<Eigen::Triplet<double>> t;
-      for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
-      Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
-      for (const auto& e : t) lumped(e.row()) += e.value();
-      for (Eigen::Index j = 0; j < lumped.size(); ++j) {
-        const double a = r.coefficient(j) * lumped(j);
-        for (int c = 0; c < Dim; ++c) {
-          const int k = im.dof.velocity(interface_nodes_[static_cast<std::size_t>(j)], c);
-          const double b = a * r.velocity(Dim * j + c) + r.traction(Dim * j + c);
-          ranks::add_to_system(sys, 1, &k, 1, &k, &a);
-          ranks::add_to_rhs(sys, 1, &k, &b);
-        }
-      }
-    } else {
-      const detail::NitscheInputT<Dim> nitsche{X_, penalty_positions(), interface_velocity_, params_};
-      detail::LocalSystem s;
-      std::vector<int> scratch;
-      for (const auto& edge : im.edges) {
-        im.element->nitsche(edge, nitsche, s);
-        const int* d = im.unknowns_of(edge.element, scratch);
-        const auto n = static_cast<int>(s.rhs.size());
-        ranks::add_to_system(sys, n, d, n, d, s.matrix.data());
-        ranks::add_to_rhs(sys, n, d, s.rhs.data());
+  auto& x = im.extras;
+  const int local = im.element->local_size();
+  const auto blocks = static_cast<std::size_t>(local) * static_cast<std::size_t>(local);
+  if (x.rows.empty()) {
+    std::vector<int> d(static_cast<std::size_t>(local));
+    for (const auto& edge : im.edges) {
+      im.element->element_dofs(edge.element, d.data());
+      for (int j = 0; j < local; ++j)
+        for (int i = 0; i < local; ++i)
+          x.rows.push_back(d[static_cast<std::size_t>(i)]), x.cols.push_back(d[static_cast<std::size_t>(j)]);
+    }
+    for (int node : interface_nodes_)
+      for (int c = 0; c < Dim; ++c) x.rows.push_back(im.dof.velocity(node, c)), x.cols.push_back(x.rows.back());
+    x.values.assign(x.rows.size(), 0.0);
+  }
+  std::fill(x.values.begin(), x.values.end(), 0.0);
+  x.rhs_rows.clear(), x.rhs_values.clear();
+  for (Eigen::Index i = 0; i < im.rhs_volume.size(); ++i)
+    if (im.rhs_volume(i) != 0) x.rhs_rows.push_back(static_cast<int>(i)), x.rhs_values.push_back(im.rhs_volume(i));
+  if (step.robin) {
+    const RobinCondition& r = *step.robin;
+    std::vector<Eigen::Triplet<double>> t;
+    for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
+    Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
+    for (const auto& e : t) lumped(e.row()) += e.value();
+    const std::size_t diagonal = im.edges.size() * blocks;
+    for (Eigen::Index j = 0; j < lumped.size(); ++j) {
+      const double a = r.coefficient(j) * lumped(j);
+      for (int c = 0; c < Dim; ++c) {
+        x.values[diagonal + static_cast<std::size_t>(Dim * j + c)] = a;
+        x.rhs_rows.push_back(im.dof.velocity(interface_nodes_[static_cast<std::size_t>(j)], c));
+        x.rhs_values.push_back(a * r.velocity(Dim * j + c) + r.traction(Dim * j + c));
       }
     }
-  };
+  } else {
+    const detail::NitscheInputT<Dim> nitsche{X_, penalty_positions(), interface_velocity_, params_};
+    detail::LocalSystem s;
+    std::vector<int> d(static_cast<std::size_t>(local));
+    for (std::size_t f = 0; f < im.edges.size(); ++f) {
+      im.element->nitsche(im.edges[f], nitsche, s);
+      std::copy(s.matrix.data(), s.matrix.data() + blocks, x.values.begin() + static_cast<long>(f * blocks));
+      im.element->element_dofs(im.edges[f].element, d.data());
+      for (int i = 0; i < local; ++i)
+        x.rhs_rows.push_back(d[static_cast<std::size_t>(i)]), x.rhs_values.push_back(s.rhs(i));
+    }
+  }
+  auto part = im.part->view();
+  part.extra_count = static_cast<int>(x.rows.size());
+  part.extra_rows = x.rows.data(), part.extra_cols = x.cols.data(), part.extra_values = x.values.data();
+  part.extra_rhs_count = static_cast<int>(x.rhs_rows.size());
+  part.extra_rhs_rows = x.rhs_rows.data(), part.extra_rhs_values = x.rhs_values.data();
   std::vector<int> rows;
   std::vector<double> values;
   for (std::size_t i = 0; i < step.constraints.on.size(); ++i)
     if (step.constraints.on[i])
       rows.push_back(static_cast<int>(i)), values.push_back(step.constraints.value(static_cast<Eigen::Index>(i)));
   try {
-    ranks::fill_system(sys, im.part->view(), extras, rows, values);
+    ranks::fill_system(im.system, part, rows, values);
   } catch (const std::runtime_error& e) {
     throw SolverError(
         fmt::format("fluid step at t = {:.6g}: filling the distributed matrix failed: {}", step.time, e.what()));

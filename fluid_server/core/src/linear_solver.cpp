@@ -78,11 +78,9 @@ void broadcast(int*, std::size_t) {}
 void broadcast(std::string&) {}
 void sum_to_root(double*, std::size_t) {}
 void gather_to_root(const double* mine, int count, double* all) { std::copy(mine, mine + count, all); }
-void fill_system(int, const Part&, const std::function<void()>&, const std::vector<int>&, const std::vector<double>&) {
+void fill_system(int, const Part&, const std::vector<int>&, const std::vector<double>&) {
   throw std::logic_error("fill_system: this build has no PETSc");
 }
-void add_to_system(int, int, const int*, int, const int*, const double*) {}
-void add_to_rhs(int, int, const int*, const double*) {}
 }  // namespace ranks
 #endif
 

@@ -6,7 +6,6 @@
 // same collective calls below, in the same order. Implemented in petsc_solver.cpp (the one
 // source that sees MPI); a build without PETSc has one rank and every call is a no-op.
 #include <cstddef>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -41,7 +40,9 @@ void gather_to_root(const double* mine, int count, double* all);
 // `id`: the PETSc solver's (LinearSolver::partition_id).
 
 // One rank's part of the matrix and right-hand side: a square matrix on the rank's own unknowns
-// (CSC with local indices) and the map from its local unknowns to the system's.
+// (CSC with local indices) and the map from its local unknowns to the system's; on rank 0 also
+// entries of its own (the interface terms: rows and columns of the system; a pattern fixed from
+// the first fill on, values every fill) and right-hand side entries (any, every fill).
 struct Part {
   int unknowns = 0;  // of the whole system
   int columns = 0;   // local unknowns
@@ -50,18 +51,20 @@ struct Part {
   const double* values = nullptr;
   const int* global = nullptr;  // local unknown -> the system's
   const double* rhs = nullptr;  // per local unknown
+  int extra_count = 0;
+  const int* extra_rows = nullptr;
+  const int* extra_cols = nullptr;
+  const double* extra_values = nullptr;
+  int extra_rhs_count = 0;
+  const int* extra_rhs_rows = nullptr;
+  const double* extra_rhs_values = nullptr;
 };
 
-// Collective: the system's matrix and right-hand side become the sum of every rank's part and of
-// what `extras` (called on rank 0 only) adds; then the rows `rows` (rank 0's list; the others
-// pass none) become identity rows with right-hand side `values`. The first call (and one with
-// another number of unknowns) takes the pattern from the parts. Throws std::runtime_error with
+// Collective: the system's matrix and right-hand side become the sum of every rank's part; then
+// the rows `rows` (rank 0's list; the others pass none) become identity rows with right-hand side
+// `values`. The first fill (and one with another number of unknowns) takes the pattern from the
+// parts (PETSc's COO assembly: later fills only move values). Throws std::runtime_error with
 // PETSc's message on a failure (every rank alike).
-void fill_system(int id, const Part& part, const std::function<void()>& extras, const std::vector<int>& rows,
-                 const std::vector<double>& values);
-// Rank 0, inside `extras`: a dense m x n block (column-major) at the rows and columns given, and
-// right-hand side entries, added (indices of the whole system, inside the parts' pattern).
-void add_to_system(int id, int m, const int* rows, int n, const int* cols, const double* block);
-void add_to_rhs(int id, int m, const int* rows, const double* values);
+void fill_system(int id, const Part& part, const std::vector<int>& rows, const std::vector<double>& values);
 
 }  // namespace fsi::fluid::ranks

@@ -203,18 +203,23 @@ class PetscSystem {
     return kt && std::string(kt) == KSPPREONLY;
   }
 
-  // Collective (mpi_ranks.hpp, fill_system): A and b from every rank's part, rank 0's extras,
-  // then the constrained rows.
-  void fill(const ranks::Part& part, const std::function<void()>& extras, const std::vector<int>& rows,
-            const std::vector<double>& values) {
+  // Collective (mpi_ranks.hpp, fill_system): A and b from every rank's part, then the
+  // constrained rows.
+  void fill(const ranks::Part& part, const std::vector<int>& rows, const std::vector<double>& values) {
     if (!A_ || !filled_ || n_ != part.unknowns) create_filled(part);
-    FSI_PETSC(MatZeroEntries(A_));
+    const PetscScalar* v = part.values;
+    if (part.extra_count > 0) {  // one array: the part's values, then the extra entries'
+      const auto own = static_cast<std::size_t>(part.colptr[part.columns]);
+      coo_values_.resize(own + static_cast<std::size_t>(part.extra_count));
+      std::copy(part.values, part.values + own, coo_values_.begin());
+      std::copy(part.extra_values, part.extra_values + part.extra_count, coo_values_.begin() + static_cast<long>(own));
+      v = coo_values_.data();
+    }
+    FSI_PETSC(MatSetValuesCOO(A_, v, INSERT_VALUES));
     FSI_PETSC(VecZeroEntries(b_));
-    add_part(A_, part, true);
     FSI_PETSC(VecSetValues(b_, part.columns, part.global, part.rhs, ADD_VALUES));
-    if (g_rank == 0) extras();
-    FSI_PETSC(MatAssemblyBegin(A_, MAT_FINAL_ASSEMBLY));
-    FSI_PETSC(MatAssemblyEnd(A_, MAT_FINAL_ASSEMBLY));
+    if (part.extra_rhs_count > 0)
+      FSI_PETSC(VecSetValues(b_, part.extra_rhs_count, part.extra_rhs_rows, part.extra_rhs_values, ADD_VALUES));
     FSI_PETSC(VecAssemblyBegin(b_));
     FSI_PETSC(VecAssemblyEnd(b_));
     // Identity rows, rhs the value: MatZeroRows sets b = x on them.
@@ -225,55 +230,35 @@ class PetscSystem {
     FSI_PETSC(VecAssemblyEnd(x_));
     FSI_PETSC(MatZeroRows(A_, count, rows.data(), 1.0, x_, b_));
   }
-  void add_block(int m, const int* rows, int n, const int* cols, const double* block) {
-    FSI_PETSC(MatSetOption(A_, MAT_ROW_ORIENTED, PETSC_FALSE));
-    FSI_PETSC(MatSetValues(A_, m, rows, n, cols, block, ADD_VALUES));
-    FSI_PETSC(MatSetOption(A_, MAT_ROW_ORIENTED, PETSC_TRUE));
-  }
-  void add_rhs(int m, const int* rows, const double* values) {
-    FSI_PETSC(VecSetValues(b_, m, rows, values, ADD_VALUES));
-  }
 
  private:
   bool filled_ = false;
-  std::vector<PetscInt> column_rows_;  // scratch: one column's rows in the system's numbering
+  std::vector<PetscScalar> coo_values_;  // rank 0 with extra entries: all its values in one array
 
-  // The part's columns into M (values, or zeros for the preallocator).
-  void add_part(Mat M, const ranks::Part& part, bool values) {
-    std::vector<PetscScalar> zeros;
-    for (int j = 0; j < part.columns; ++j) {
-      const int first = part.colptr[j], count = part.colptr[j + 1] - first;
-      column_rows_.resize(static_cast<std::size_t>(count));
-      for (int k = 0; k < count; ++k) column_rows_[static_cast<std::size_t>(k)] = part.global[part.rowind[first + k]];
-      const PetscInt col = part.global[j];
-      if (!values) zeros.assign(static_cast<std::size_t>(count), 0.0);
-      FSI_PETSC(MatSetValues(M, count, column_rows_.data(), 1, &col, values ? part.values + first : zeros.data(),
-                             ADD_VALUES));
-    }
-  }
-
-  // The matrix of a filled system: rows in blocks over the ranks, preallocated from the union of
-  // the parts' patterns (MATPREALLOCATOR); the pattern is kept by every later fill.
+  // The matrix of a filled system: rows in blocks over the ranks, the pattern and the plan of the
+  // assembly (which values go to which rank and position) from every rank's entries once
+  // (MatSetPreallocationCOO); the constraints keep the pattern.
   void create_filled(const ranks::Part& part) {
     release();
     n_ = part.unknowns;
     set_layout();
     const PetscInt local = end_ - start_;
-    Mat P = nullptr;
-    FSI_PETSC(MatCreate(PETSC_COMM_WORLD, &P));
-    FSI_PETSC(MatSetSizes(P, local, local, n_, n_));
-    FSI_PETSC(MatSetType(P, MATPREALLOCATOR));
-    FSI_PETSC(MatSetUp(P));
-    add_part(P, part, false);
-    FSI_PETSC(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
-    FSI_PETSC(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
     FSI_PETSC(MatCreate(PETSC_COMM_WORLD, &A_));
     FSI_PETSC(MatSetSizes(A_, local, local, n_, n_));
     FSI_PETSC(MatSetType(A_, MATAIJ));
-    FSI_PETSC(MatPreallocatorPreallocate(P, PETSC_TRUE, A_));
-    MatDestroy(&P);
+    const auto own = static_cast<std::size_t>(part.colptr[part.columns]);
+    std::vector<PetscInt> coo_i(own + static_cast<std::size_t>(part.extra_count)), coo_j(coo_i.size());
+    for (int j = 0; j < part.columns; ++j)
+      for (int k = part.colptr[j]; k < part.colptr[j + 1]; ++k) {
+        coo_i[static_cast<std::size_t>(k)] = part.global[part.rowind[k]];
+        coo_j[static_cast<std::size_t>(k)] = part.global[j];
+      }
+    for (int k = 0; k < part.extra_count; ++k) {
+      coo_i[own + static_cast<std::size_t>(k)] = part.extra_rows[k];
+      coo_j[own + static_cast<std::size_t>(k)] = part.extra_cols[k];
+    }
+    FSI_PETSC(MatSetPreallocationCOO(A_, static_cast<PetscCount>(coo_i.size()), coo_i.data(), coo_j.data()));
     FSI_PETSC(MatSetOption(A_, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
-    FSI_PETSC(MatSetOption(A_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
     make_vectors();
     filled_ = true;
   }
@@ -793,21 +778,14 @@ void gather_to_root(const double* mine, int count, double* all) {
   MPI_Gather(mine, count, MPI_DOUBLE, all, count, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
 }
 
-void fill_system(int id, const Part& part, const std::function<void()>& extras, const std::vector<int>& rows,
-                 const std::vector<double>& values) {
+void fill_system(int id, const Part& part, const std::vector<int>& rows, const std::vector<double>& values) {
   static_assert(sizeof(PetscInt) == sizeof(int), "PETSc with 32-bit indices");
   try {
-    system_of(id).fill(part, extras, rows, values);
+    system_of(id).fill(part, rows, values);
   } catch (const PetscFailure& e) {
     throw std::runtime_error(e.what());
   }
 }
-
-void add_to_system(int id, int m, const int* rows, int n, const int* cols, const double* block) {
-  system_of(id).add_block(m, rows, n, cols, block);
-}
-
-void add_to_rhs(int id, int m, const int* rows, const double* values) { system_of(id).add_rhs(m, rows, values); }
 
 }  // namespace ranks
 
