@@ -111,6 +111,35 @@ TEST(PetscRanks, DistributedAndPartitionedAssembliesEqualRankZerosAlone) {
   }
 }
 
+// The backflow stabilisation, closed form: a uniform flow u = (-U, 0, 0) enters through the
+// traction-free face x = L and leaves through x = 0 (prescribed), slip walls. Without the term p =
+// 0; with it the open face's traction is beta rho (u.n) u = (beta rho U^2, 0, 0), so p = -beta rho
+// U^2 in the whole box (a uniform flow has no viscous stress). On 2 ranks the term comes from
+// rank 0 into the partitioned matrix.
+TEST(PetscRanks, BackflowStabilisationGivesTheClosedFormPressure) {
+  if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
+  const double U = 0.8, rho = 1.3, beta = 0.4;
+  for (const double b : {0.0, beta}) {
+    FlowParameters params;
+    params.density = rho;
+    params.viscosity = 0.05;
+    params.scheme = TimeScheme::Steady;
+    params.newton = true;
+    params.max_iterations = 4;
+    params.tolerance = 1e-12;
+    params.engine = LinearEngine::Mumps;
+    params.backflow_beta = b;
+    FlowSolver3 solver(TetMesh::box({0, 0, 0}, {2, 1, 0.5}, 4, 2, 2), params, "p2p1");
+    solver.add_dirichlet("left", [&](const Eigen::Vector3d&, double) -> Eigen::Vector3d { return {-U, 0, 0}; });
+    for (const char* g : {"bottom", "top", "back", "front"}) solver.add_symmetry(g);
+    solver.add_open_boundary("right");
+    solver.solve(1, 0, solver.mesh().nodes, {});
+    const double expected = -b * rho * U * U;
+    for (const Eigen::Vector3d x : {Eigen::Vector3d(1.0, 0.5, 0.25), Eigen::Vector3d(1.9, 0.2, 0.1)})
+      EXPECT_NEAR(solver.pressure_at(x), expected, 1e-9) << "beta " << b << " at " << x.transpose();
+  }
+}
+
 TEST(PetscRanks, AnInvertedCellOfAnyRanksBlockIsReported) {
   if (!petsc_available()) GTEST_SKIP() << "built without PETSc";
   FlowParameters params;

@@ -119,6 +119,13 @@ class FlowElementT {
   virtual void pressure_load(const InterfaceEdge&, const NodeMatrix<Dim>&, double, Eigen::VectorXd&) const {
     throw std::invalid_argument(std::string("the element ") + name() + " has no pressure boundaries");
   }
+  // The backflow stabilisation on a traction boundary's face (overwrites `out.matrix`, `out.rhs`
+  // zero): -coefficient int min((u* - w).n, 0) N_i N_j on each velocity component, u* the
+  // linearisation velocity U_lin, w the mesh velocity, n outward (coefficient = beta rho).
+  virtual void backflow(const InterfaceEdge&, const NodeMatrix<Dim>&, const Eigen::VectorXd&, const NodeMatrix<Dim>&,
+                        double, LocalSystem&) const {
+    throw std::invalid_argument(std::string("the element ") + name() + " has no backflow stabilisation");
+  }
   // The Nitsche terms of the edge (overwrites `out`), in the triangle's local order.
   virtual void nitsche(const InterfaceEdge& edge, const NitscheInput& in, LocalSystem& out) const = 0;
   // int N_i N_j over the edge at positions X, on the interface indices.

@@ -155,6 +155,25 @@ class P2P1TetElement final : public FlowElementT<3> {
         for (int c = 0; c < 3; ++c) load(3 * i + c) -= p * q.weight * fp.ds * fp.N(i) * fp.normal(c);
     }
   }
+  void backflow(const InterfaceEdge& face, const NodeMatrix<3>& X, const Eigen::VectorXd& U_lin,
+                const NodeMatrix<3>& mesh_velocity, double coefficient, LocalSystem& out) const override {
+    const auto x = element_positions(X, face.element);
+    const auto w = element_positions(mesh_velocity, face.element);
+    const auto nodes = mesh_.element_nodes10(face.element);
+    Eigen::Matrix<double, 10, 3> u;
+    for (int k = 0; k < 10; ++k) u.row(k) = U_lin.segment<3>(3 * nodes(k)).transpose();
+    out.matrix.setZero(34, 34);
+    out.rhs.setZero(34);
+    for (const auto& q : fsi::face_quadrature(6)) {
+      const auto p = face_point(x, face, q.xi, q.eta);
+      const double flux = ((u - w).transpose() * p.N).dot(p.normal);
+      if (flux >= 0) continue;
+      const double a = -coefficient * flux * q.weight * p.ds;
+      for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j)
+          for (int c = 0; c < 3; ++c) out.matrix(3 * i + c, 3 * j + c) += a * p.N(i) * p.N(j);
+    }
+  }
   void interface_mass(const InterfaceEdge& face, const NodeMatrix<3>& X,
                       std::vector<Eigen::Triplet<double>>& t) const override {
     const auto x = element_positions(X, face.element);

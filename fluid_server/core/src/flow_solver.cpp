@@ -612,6 +612,25 @@ struct BasicFlowSolver<Dim>::Impl {
     std::function<double(double)> pressure;
   };
   std::vector<PressureCondition> pressures;  // normal tractions -p n (add_pressure)
+  std::vector<detail::InterfaceEdge> open;   // traction-free faces (add_open_boundary)
+  // The backflow stabilisation's faces: every pressure boundary's, then the open ones; `active`:
+  // whether each is traction-free at `time` (a pressure boundary while its pressure is 0).
+  std::vector<const detail::InterfaceEdge*> backflow_faces(double time = 0, std::vector<char>* active = nullptr) const {
+    std::vector<const detail::InterfaceEdge*> faces;
+    for (const auto& c : pressures) {
+      const bool free = active && c.pressure(time) == 0;
+      for (const auto& t : c.traces) {
+        faces.push_back(&t);
+        if (active) active->push_back(free);
+      }
+    }
+    for (const auto& t : open) {
+      faces.push_back(&t);
+      if (active) active->push_back(1);
+    }
+    return faces;
+  }
+  std::vector<Eigen::MatrixXd> backflow_blocks;  // partitioned: the last fill's, per face (reactions)
   int pressure_vertex = -1;
   std::function<double(double)> pressure_value;
   Velocity body_force;
@@ -849,6 +868,16 @@ void BasicFlowSolver<Dim>::add_pressure(const std::string& group, std::function<
 }
 
 template <int Dim>
+void BasicFlowSolver<Dim>::add_open_boundary(const std::string& group) {
+  std::map<int, int> index;
+  for (int node : mesh().boundary_nodes({group})) index[node] = static_cast<int>(index.size());
+  std::vector<std::array<int, 2>> segs;
+  std::vector<std::array<int, 6>> faces;
+  const auto traces = impl_->traces({group}, index, segs, faces);
+  impl_->open.insert(impl_->open.end(), traces.begin(), traces.end());
+}
+
+template <int Dim>
 void BasicFlowSolver<Dim>::set_pressure_reference(const PointD& point, std::function<double(double)> value) {
   Eigen::Index best = 0;
   (mesh().nodes.topRows(mesh().vertices()).rowwise() - point.transpose()).rowwise().squaredNorm().minCoeff(&best);
@@ -954,6 +983,26 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
       for (Eigen::Index i = 0; i < load.size(); ++i) im.rhs_volume(d[i]) += load(i);
     }
   }
+  // The backflow stabilisation of the traction-free boundaries (outlets; pressure boundaries while
+  // their pressure is 0): part of the volume residual, as their loads (the reactions of nodes
+  // shared with the interface keep the interface's traction only).
+  if (params_.backflow_beta > 0) {
+    detail::LocalSystem s;
+    std::vector<char> active;
+    const auto faces = im.backflow_faces(step.time, &active);
+    im.backflow_blocks.resize(faces.size());
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      if (!active[f]) {
+        im.backflow_blocks[f].setZero(im.element->local_size(), im.element->local_size());
+        continue;
+      }
+      im.element->backflow(*faces[f], X_, U_lin, step.mesh_velocity, params_.backflow_beta * params_.density, s);
+      if (im.partitioned())
+        im.backflow_blocks[f] = s.matrix;
+      else
+        im.add(faces[f]->element, s, im.volume.valuePtr(), im.rhs_volume);
+    }
+  }
   if (im.partitioned()) {
     fill_partitioned(step);
     report.assembly_seconds += seconds_since(t_assembly);
@@ -1001,8 +1050,12 @@ void BasicFlowSolver<Dim>::fill_partitioned(const Step& step) {
   const auto blocks = static_cast<std::size_t>(local) * static_cast<std::size_t>(local);
   if (x.rows.empty()) {
     std::vector<int> d(static_cast<std::size_t>(local));
-    for (const auto& edge : im.edges) {
-      im.element->element_dofs(edge.element, d.data());
+    std::vector<int> cells;
+    for (const auto& edge : im.edges) cells.push_back(edge.element);
+    if (params_.backflow_beta > 0)
+      for (const auto* face : im.backflow_faces()) cells.push_back(face->element);
+    for (int cell : cells) {
+      im.element->element_dofs(cell, d.data());
       for (int j = 0; j < local; ++j)
         for (int i = 0; i < local; ++i)
           x.rows.push_back(d[static_cast<std::size_t>(i)]), x.cols.push_back(d[static_cast<std::size_t>(j)]);
@@ -1021,7 +1074,7 @@ void BasicFlowSolver<Dim>::fill_partitioned(const Step& step) {
     for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
     Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
     for (const auto& e : t) lumped(e.row()) += e.value();
-    const std::size_t diagonal = im.edges.size() * blocks;
+    const std::size_t diagonal = (im.edges.size() + im.backflow_blocks.size()) * blocks;
     for (Eigen::Index j = 0; j < lumped.size(); ++j) {
       const double a = r.coefficient(j) * lumped(j);
       for (int c = 0; c < Dim; ++c) {
@@ -1042,6 +1095,9 @@ void BasicFlowSolver<Dim>::fill_partitioned(const Step& step) {
         x.rhs_rows.push_back(d[static_cast<std::size_t>(i)]), x.rhs_values.push_back(s.rhs(i));
     }
   }
+  for (std::size_t f = 0; f < im.backflow_blocks.size(); ++f)
+    std::copy(im.backflow_blocks[f].data(), im.backflow_blocks[f].data() + blocks,
+              x.values.begin() + static_cast<long>((im.edges.size() + f) * blocks));
   auto part = im.part->view();
   part.extra_count = static_cast<int>(x.rows.size());
   part.extra_rows = x.rows.data(), part.extra_cols = x.cols.data(), part.extra_values = x.values.data();
@@ -1069,6 +1125,16 @@ Eigen::VectorXd BasicFlowSolver<Dim>::partitioned_reaction() {
   ranks::broadcast(U.data(), static_cast<std::size_t>(U.size()));
   if constexpr (Dim == 3) add_part_reaction(*im.part, U, reaction);
   ranks::sum_to_root(reaction.data(), static_cast<std::size_t>(reaction.size()));
+  // The backflow terms are part of the volume residual (assemble): their share, from this rank.
+  const auto faces = im.backflow_faces();
+  std::vector<int> d(static_cast<std::size_t>(im.element->local_size()));
+  for (std::size_t f = 0; f < im.backflow_blocks.size(); ++f) {
+    im.element->element_dofs(faces[f]->element, d.data());
+    Eigen::VectorXd u(static_cast<Eigen::Index>(d.size()));
+    for (std::size_t i = 0; i < d.size(); ++i) u(static_cast<Eigen::Index>(i)) = U(d[i]);
+    const Eigen::VectorXd r = im.backflow_blocks[f] * u;
+    for (std::size_t i = 0; i < d.size(); ++i) reaction(d[i]) += r(static_cast<Eigen::Index>(i));
+  }
   return reaction - im.rhs_volume;
 }
 

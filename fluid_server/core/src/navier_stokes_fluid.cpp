@@ -101,6 +101,7 @@ FluidMesh read_mesh(const schema::Reader& mesh_section, const std::filesystem::p
 void read_physics(const schema::Reader& section, bool taylor_hood, FlowParameters& params) {
   params.density = section.get<double>("density");
   params.viscosity = section.get<double>("viscosity");
+  params.backflow_beta = section.get<double>("backflow_stabilisation");
   const auto scheme = section.get<std::string>("scheme");
   params.scheme = scheme == "bdf1" ? TimeScheme::BDF1 : scheme == "steady" ? TimeScheme::Steady : TimeScheme::BDF2;
   // Steady Taylor-Hood problems default to Newton (P1/P1: Picard, as validated; newton on request:
@@ -354,6 +355,8 @@ void NavierStokesFluid::configure(const ConfigSection& fluid_section, const Flui
   FluidMesh mesh = read_mesh(mesh_section, msh, taylor_hood);
   FlowParameters params;
   read_physics(section, taylor_hood, params);
+  if (params.backflow_beta > 0)
+    section.fail("backflow_stabilisation", "is 3D only (fluid.dimension: 3); the 2D fluid has no backflow term");
   read_stabilisation(section, taylor_hood, params.stabilisation);
   read_linear_solver(section, taylor_hood, 2, params);
   const auto interface_groups = read_nitsche(section, setup, params);
@@ -439,8 +442,10 @@ void NavierStokesFluid::configure3(const schema::Reader& section) {
     if (!m.has_boundary(g)) section.fail("symmetry", "no boundary group '" + g + "' in " + msh.string());
     solver3_->add_symmetry(g);
   }
-  for (const auto& g : string_list(section, "outlet"))
+  for (const auto& g : string_list(section, "outlet")) {
     if (!m.has_boundary(g)) section.fail("outlet", "no boundary group '" + g + "' in " + msh.string());
+    if (params.backflow_beta > 0) solver3_->add_open_boundary(g);
+  }
   if (section.list("moving_walls").size() > 0) section.fail("moving_walls", "not in 3D yet");
   for (const auto& entry : section.list("pressures")) {
     const auto g = entry.get<std::string>("group");

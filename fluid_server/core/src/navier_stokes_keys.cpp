@@ -30,6 +30,12 @@ const std::vector<schema::Key>& navier_stokes_keys() {
           .req(),
       number("density", "rho_f").req().gt(0).in_unit("kg/m^3"),
       number("viscosity", "dynamic viscosity mu_f").req().gt(0).in_unit("Pa s"),
+      number("backflow_stabilisation",
+             "3D: beta of the backflow stabilisation of the traction-free boundaries (outlet; pressures while their "
+             "pressure is 0): where fluid enters through them their traction gains beta rho min((u - w).n, 0) u "
+             "(Bazilevs et al. 2009); 0 = off")
+          .def("0")
+          .ge(0),
       choice("scheme", {"bdf1", "bdf2", "steady"}, "time scheme").def("bdf2"),
       section("nonlinear", "nonlinear iterations per step",
               {

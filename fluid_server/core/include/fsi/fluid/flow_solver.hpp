@@ -141,6 +141,12 @@ struct FlowParameters {
   // distributed matrix; otherwise rank 0 sums the blocks into the whole matrix.
   bool distributed_assembly = true;
   bool partitioned_assembly = true;
+  // Backflow stabilisation of the traction-free boundaries (outlets, and pressure boundaries
+  // while their pressure is 0; 3D): where the fluid enters through them ((u - w).n < 0) their
+  // traction gains beta rho ((u - w).n)_- u
+  // (Bazilevs et al. 2009; Esmaily Moghadam et al. 2011), with u's flux from the linearisation
+  // velocity. 0: off (the plain traction condition).
+  double backflow_beta = 0;
   // Tests only (the GCL tests' control): the ALE mesh velocity is multiplied by this; anything
   // but 1 is a wrong mesh velocity, which a GCL test must detect.
   double mesh_velocity_scale = 1.0;
@@ -177,6 +183,9 @@ class BasicFlowSolver {
   // A prescribed normal traction sigma n = -p(t) n on a boundary group (a pressure inlet or
   // outlet; Taylor-Hood only). The rest of the boundary without conditions is do-nothing (p = 0).
   void add_pressure(const std::string& group, std::function<double(double)> pressure);
+  // A traction-free (do-nothing) boundary: nothing to add, unless FlowParameters::backflow_beta
+  // > 0 stabilises it (its faces are kept for that).
+  void add_open_boundary(const std::string& group);
   void set_interface(const std::vector<std::string>& groups);                             // Nitsche groups
   void set_pressure_reference(const PointD& point, std::function<double(double)> value);  // nearest vertex
   void set_body_force(Velocity force);
