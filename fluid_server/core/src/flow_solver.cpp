@@ -509,10 +509,6 @@ int agree_on_inverted(int bad_element, double& bad, bool& any) {
 struct ServedPart {
   std::unique_ptr<Part> part;
   int system = -1;
-  struct Extras {  // rank 0's own entries of the system (fill_partitioned)
-    std::vector<int> rows, cols, rhs_rows;
-    std::vector<double> values, rhs_values;
-  } extras;
 };
 std::map<int, ServedPart>& parts() {
   static std::map<int, ServedPart> all;
