@@ -654,6 +654,14 @@ struct BasicFlowSolver<Dim>::Impl {
     std::vector<double> values, rhs_values;
   } extras;
   bool partitioned() const { return system >= 0; }
+  // The interface mass's row sums at positions X (the Robin condition's lumped areas).
+  Eigen::VectorXd lumped_interface_mass(const NodeMatrix<Dim>& X, std::size_t nodes) const {
+    std::vector<Eigen::Triplet<double>> t;
+    for (const auto& edge : edges) element->interface_mass(edge, X, t);
+    Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nodes));
+    for (const auto& e : t) lumped(e.row()) += e.value();
+    return lumped;
+  }
   // A cell's unknowns in the system (the pattern's, or the element's in the partitioned mode).
   const int* unknowns_of(int e, std::vector<int>& scratch) const {
     if (!partitioned()) return cells.dofs_of(e);
@@ -1010,10 +1018,7 @@ void BasicFlowSolver<Dim>::assemble(const Step& step, const Eigen::VectorXd& U_l
     // The Robin condition, lumped: A_j (v_j - v*_j) - f*_j on node j's momentum rows, A_j =
     // coefficient_j int N_j (the interface mass's row sum on the current interface).
     const RobinCondition& r = *step.robin;
-    std::vector<Eigen::Triplet<double>> t;
-    for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
-    Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
-    for (const auto& e : t) lumped(e.row()) += e.value();
+    const Eigen::VectorXd lumped = im.lumped_interface_mass(X_, interface_nodes_.size());
     for (Eigen::Index j = 0; j < lumped.size(); ++j) {
       const double a = r.coefficient(j) * lumped(j);
       for (int c = 0; c < Dim; ++c) {
@@ -1066,10 +1071,7 @@ void BasicFlowSolver<Dim>::fill_partitioned(const Step& step) {
     if (im.rhs_volume(i) != 0) x.rhs_rows.push_back(static_cast<int>(i)), x.rhs_values.push_back(im.rhs_volume(i));
   if (step.robin) {
     const RobinCondition& r = *step.robin;
-    std::vector<Eigen::Triplet<double>> t;
-    for (const auto& edge : im.edges) im.element->interface_mass(edge, X_, t);
-    Eigen::VectorXd lumped = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(interface_nodes_.size()));
-    for (const auto& e : t) lumped(e.row()) += e.value();
+    const Eigen::VectorXd lumped = im.lumped_interface_mass(X_, interface_nodes_.size());
     const std::size_t diagonal = (im.edges.size() + im.backflow_blocks.size()) * blocks;
     for (Eigen::Index j = 0; j < lumped.size(); ++j) {
       const double a = r.coefficient(j) * lumped(j);
